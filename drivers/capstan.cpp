@@ -1,0 +1,106 @@
+// capstan command line (interface.md): run | validate | params | --version.
+#include <Teuchos_DefaultComm.hpp>
+#include <Teuchos_XMLParameterListHelpers.hpp>
+#include <Tpetra_Core.hpp>
+
+#include <cstring>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "errors.hpp"
+#include "scene.hpp"
+#include "simulation.hpp"
+
+namespace {
+
+const char* kUsage =
+    "usage: capstan run SCENE.xml [--output DIR] [--set PATH=VALUE]... [--quiet]\n"
+    "       capstan validate SCENE.xml [--set PATH=VALUE]...\n"
+    "       capstan params\n"
+    "       capstan --version\n";
+
+struct Args {
+  std::string command, scene, output;
+  std::vector<std::string> sets;
+  bool quiet = false;
+};
+
+// Returns false (with a message) on a malformed command line.
+bool parse(int argc, char** argv, Args& a, std::string& error) {
+  if (argc < 2) {
+    error = "missing command";
+    return false;
+  }
+  a.command = argv[1];
+  for (int i = 2; i < argc; ++i) {
+    const std::string s = argv[i];
+    auto value = [&](const char* flag) {
+      if (i + 1 >= argc) throw std::runtime_error(std::string(flag) + " needs a value");
+      return std::string(argv[++i]);
+    };
+    try {
+      if (s == "--output") a.output = value("--output");
+      else if (s == "--set") a.sets.push_back(value("--set"));
+      else if (s.rfind("--set=", 0) == 0) a.sets.push_back(s.substr(6));
+      else if (s.rfind("--output=", 0) == 0) a.output = s.substr(9);
+      else if (s == "--quiet") a.quiet = true;
+      else if (!s.empty() && s[0] == '-') throw std::runtime_error("unknown option " + s);
+      else if (a.scene.empty()) a.scene = s;
+      else throw std::runtime_error("unexpected argument " + s);
+    } catch (const std::exception& e) {
+      error = e.what();
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Tpetra::ScopeGuard tpetra(&argc, &argv);
+  auto comm = Tpetra::getDefaultComm();
+  const bool rank0 = comm->getRank() == 0;
+  Args args;
+  std::string error;
+  if (!parse(argc, argv, args, error)) {
+    if (rank0) std::cerr << "capstan: " << error << "\n" << kUsage;
+    return 1;
+  }
+  if (args.command == "--version" || args.command == "version") {
+    if (rank0) std::cout << "capstan " << CAPSTAN_VERSION << "\n";
+    return 0;
+  }
+  if (args.command == "params") {
+    if (rank0)
+      capstan::validParameters().print(std::cout, Teuchos::ParameterList::PrintOptions().showDoc(true).showTypes(true).indent(2));
+    return 0;
+  }
+  if (args.command == "--help" || args.command == "help") {
+    if (rank0) std::cout << kUsage;
+    return 0;
+  }
+  if (args.command != "run" && args.command != "validate") {
+    if (rank0) std::cerr << "capstan: unknown command '" << args.command << "'\n" << kUsage;
+    return 1;
+  }
+  if (args.scene.empty()) {
+    if (rank0) std::cerr << "capstan: " << args.command << " needs a scene file\n" << kUsage;
+    return 1;
+  }
+  try {
+    const auto scene = capstan::loadScene(args.scene, args.sets, args.output);
+    if (args.command == "validate") {
+      if (rank0) Teuchos::writeParameterListToXmlOStream(scene.resolved, std::cout);
+      return 0;
+    }
+    return capstan::runScene(scene, comm, {args.quiet});
+  } catch (const capstan::InputError& e) {
+    if (rank0) std::cerr << "capstan: error: " << e.what() << "\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "capstan: internal error on rank " << comm->getRank() << ": " << e.what() << "\n";
+    return 3;
+  }
+}

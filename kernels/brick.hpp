@@ -1,0 +1,129 @@
+// Q1P0 incompressible neo-Hookean brick (formulation.md §1).
+//
+// Cauchy stress sigma = -p I + 2c (B - I), integrated over the current volume:
+//   R_u[a,i] = int J [2c (F D_a - d_a)_i - p d_a,i] dV,   d_a = F^{-T} D_a,
+// where D_a = dN_a/dX. The element pressure is condensed with the penalty eps:
+//   p(x) = pbar - (v - V) / (eps V),
+// so the element residual is R_u(x, p(x)) and its exact tangent is
+//   K(x, p) + g g^T / (eps V),   g = int J d_a dV = d v / d x.
+// pbar is the pressure anchor the outer (augmentation) loop updates until v = V.
+#pragma once
+
+#include "hex_shape.hpp"
+
+namespace capstan::kernels {
+
+struct BrickState {
+  double volume;    // current volume v
+  double pressure;  // p(x)
+  double minJ;      // smallest det F at a Gauss point (<= 0: inverted)
+};
+
+// Deformation gradient F[i][J] = sum_a x_a,i D_a,J.
+KOKKOS_INLINE_FUNCTION void deformationGradient(const double x[8][3], const double D[8][3],
+                                                double F[3][3]) {
+  for (int i = 0; i < 3; ++i)
+    for (int J = 0; J < 3; ++J) {
+      double s = 0;
+      for (int a = 0; a < 8; ++a) s += x[a][i] * D[a][J];
+      F[i][J] = s;
+    }
+}
+
+// Current volume of the element (2x2x2 Gauss) and the smallest Gauss-point J.
+KOKKOS_INLINE_FUNCTION double brickVolume(const double X[8][3], const double x[8][3],
+                                          double& minJ) {
+  double v = 0;
+  minJ = 1e300;
+  for (int q = 0; q < 8; ++q) {
+    double D[8][3];
+    const double w = hexReferenceGradients(X, gauss2(q & 1), gauss2((q >> 1) & 1),
+                                           gauss2(q >> 2), D);
+    double F[3][3];
+    deformationGradient(x, D, F);
+    const double J = det3(F);
+    minJ = J < minJ ? J : minJ;
+    v += J * w;
+  }
+  return v;
+}
+
+// Residual R[24] (dof 3a+i) and, if K is not null, the tangent K[24*24]
+// (row-major) of one brick. V: reference volume.
+KOKKOS_INLINE_FUNCTION void brickResidualTangent(const double X[8][3], const double x[8][3],
+                                                 double V, double pbar, double c, double eps,
+                                                 double* R, double* K, BrickState& out) {
+  const bool wantTangent = K != nullptr;
+  out.volume = brickVolume(X, x, out.minJ);
+  const double p = pbar - (out.volume - V) / (eps * V);
+  out.pressure = p;
+  const double q = p + 2 * c;  // sigma = -q I + 2c B
+  double g[24];
+  for (int r = 0; r < 24; ++r) R[r] = g[r] = 0;
+  if (wantTangent)
+    for (int r = 0; r < 576; ++r) K[r] = 0;
+
+  for (int gp = 0; gp < 8; ++gp) {
+    double D[8][3];
+    const double w = hexReferenceGradients(X, gauss2(gp & 1), gauss2((gp >> 1) & 1),
+                                           gauss2(gp >> 2), D);
+    double F[3][3], Finv[3][3];
+    deformationGradient(x, D, F);
+    const double J = inverse3(F, Finv);
+    const double wJ = w * J;
+    double d[8][3], G[8][3];  // spatial gradients F^{-T} D_a and push-forward F D_a
+    for (int a = 0; a < 8; ++a)
+      for (int i = 0; i < 3; ++i) {
+        d[a][i] = Finv[0][i] * D[a][0] + Finv[1][i] * D[a][1] + Finv[2][i] * D[a][2];
+        G[a][i] = F[i][0] * D[a][0] + F[i][1] * D[a][1] + F[i][2] * D[a][2];
+      }
+    for (int a = 0; a < 8; ++a)
+      for (int i = 0; i < 3; ++i) {
+        R[3 * a + i] += wJ * (2 * c * G[a][i] - q * d[a][i]);
+        g[3 * a + i] += wJ * d[a][i];
+      }
+    if (!wantTangent) continue;
+    // dP/dF contracted with D_a, D_b (P = 2cJ F - qJ F^{-T}, q at fixed p):
+    //   J [2c (G_a,i d_b,k + delta_ik D_a.D_b) - q (d_a,i d_b,k - d_a,k d_b,i)]
+    for (int a = 0; a < 8; ++a)
+      for (int b = 0; b < 8; ++b) {
+        const double DaDb = D[a][0] * D[b][0] + D[a][1] * D[b][1] + D[a][2] * D[b][2];
+        for (int i = 0; i < 3; ++i) {
+          double* row = K + (3 * a + i) * 24 + 3 * b;
+          for (int k = 0; k < 3; ++k)
+            row[k] += wJ * (2 * c * (G[a][i] * d[b][k] + (i == k ? DaDb : 0.0)) -
+                            q * (d[a][i] * d[b][k] - d[a][k] * d[b][i]));
+        }
+      }
+  }
+  // p(x) enters R_u as -p g: condensed term g g^T / (eps V).
+  const double s = 1.0 / (eps * V);
+  if (wantTangent)
+    for (int r = 0; r < 24; ++r)
+      for (int t = 0; t < 24; ++t) K[r * 24 + t] += s * g[r] * g[t];
+}
+
+// Cauchy stress at the centroid, Voigt order xx yy zz xy yz xz.
+KOKKOS_INLINE_FUNCTION void brickCentroidStress(const double X[8][3], const double x[8][3],
+                                                double p, double c, double sigma[6]) {
+  double D[8][3], F[3][3];
+  hexReferenceGradients(X, 0, 0, 0, D);
+  deformationGradient(x, D, F);
+  double B[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) B[i][j] = F[i][0] * F[j][0] + F[i][1] * F[j][1] + F[i][2] * F[j][2];
+  sigma[0] = -p + 2 * c * (B[0][0] - 1);
+  sigma[1] = -p + 2 * c * (B[1][1] - 1);
+  sigma[2] = -p + 2 * c * (B[2][2] - 1);
+  sigma[3] = 2 * c * B[0][1];
+  sigma[4] = 2 * c * B[1][2];
+  sigma[5] = 2 * c * B[0][2];
+}
+
+KOKKOS_INLINE_FUNCTION double vonMises(const double s[6]) {
+  const double m = (s[0] + s[1] + s[2]) / 3;
+  const double a = s[0] - m, b = s[1] - m, cc = s[2] - m;
+  return sqrt(1.5 * (a * a + b * b + cc * cc + 2 * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5])));
+}
+
+}  // namespace capstan::kernels

@@ -1,0 +1,174 @@
+#include "assembly.hpp"
+
+#include <Kokkos_Timer.hpp>
+#include <Teuchos_CommHelpers.hpp>
+
+namespace capstan {
+
+Assembly::Assembly(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
+  // Effects the scene calls for, and nothing else.
+  const double epsSolve =
+      std::max(scene.pressurePenalty, scene.solver.get<double>("Minimum Solve Penalty") / scene.c);
+  auto bricks = std::make_unique<BrickEffect>(mesh, scene.c, epsSolve);
+  bricks_ = bricks.get();
+  effects_.push_back(std::move(bricks));
+  const size_t ndof = 3 * mesh.numOverlapNodes();
+  constraints_.supportOf.assign(ndof, -1);
+  constraints_.velocity.assign(ndof, 0.0);
+  for (const auto& s : scene.supports) {
+    if (s.type == "Foundation") {
+      auto f = std::make_unique<FoundationEffect>("foundation:" + s.name, mesh, s.face, s.stiffness,
+                                                  s.components);
+      foundations_.push_back(f.get());
+      effects_.push_back(std::move(f));
+      continue;
+    }
+    // Fixed, Roller, Displacement: the first support in the scene that holds a
+    // dof owns it (and its reaction).
+    const int id = int(constraints_.supportNames.size());
+    constraints_.supportNames.push_back(s.name);
+    for (int n : mesh.faceNodes(s.face))
+      for (int i = 0; i < 3; ++i) {
+        if (!s.components[i] || constraints_.supportOf[3 * n + i] >= 0) continue;
+        constraints_.supportOf[3 * n + i] = id;
+        constraints_.velocity[3 * n + i] = s.type == "Displacement" ? s.velocity[i] : 0.0;
+      }
+  }
+
+  // Graph from every effect's entities: built once, fixed sparsity.
+  importer_ = rcp(new Tpetra::Import<>(mesh.ownedDofMap, mesh.overlapDofMap));
+  // Global column ids: the owner of a shared row also receives columns that only
+  // other ranks' elements touch, so the column map is built by Tpetra after the
+  // export, not taken from this rank's nodes.
+  graph_ = rcp(new FEGraph(mesh.ownedDofMap, mesh.overlapDofMap, 81, importer_));
+  graph_->beginAssembly();
+  const auto& overlap = *mesh.overlapDofMap;
+  for (const auto& effect : effects_) {
+    auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), effect->local().dofs);
+    std::vector<GO> cols(dofs.extent(1));
+    for (size_t e = 0; e < dofs.extent(0); ++e) {
+      for (size_t k = 0; k < cols.size(); ++k) cols[k] = overlap.getGlobalElement(dofs(e, k));
+      for (GO row : cols) graph_->insertGlobalIndices(row, Teuchos::ArrayView<const GO>(cols));
+    }
+  }
+  graph_->endAssembly();
+  // Each effect's dofs as local column ids of the assembled matrix.
+  const auto& colMap = *graph_->getColMap();
+  for (const auto& effect : effects_) {
+    auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), effect->local().dofs);
+    std::vector<LO> cols(dofs.size());
+    for (size_t e = 0; e < dofs.extent(0); ++e)
+      for (size_t k = 0; k < dofs.extent(1); ++k)
+        cols[e * dofs.extent(1) + k] = colMap.getLocalElement(overlap.getGlobalElement(dofs(e, k)));
+    columns_.push_back(std::move(cols));
+  }
+  uOverlap_ = rcp(new Vector(mesh.overlapDofMap));
+  residual_ = rcp(new Tpetra::FEMultiVector<>(mesh.ownedDofMap, importer_, 1));
+  x_ = NodalVectors("x", mesh.numOverlapNodes());
+  u_ = NodalVectors("u", mesh.numOverlapNodes());
+}
+
+RCP<FEMatrix> Assembly::createMatrix() const { return rcp(new FEMatrix(graph_)); }
+
+void Assembly::applyConstraints(Vector& u, double t) const {
+  auto data = u.getDataNonConst();
+  for (LO d = 0; d < LO(data.size()); ++d)
+    if (constraints_.supportOf[d] >= 0) data[d] = constraints_.velocity[d] * t;
+}
+
+bool Assembly::evaluate(const Vector& u, Vector* f, FEMatrix* W) {
+  Kokkos::Timer timer;
+  uOverlap_->doImport(u, *importer_, Tpetra::INSERT);
+  {
+    auto ud = uOverlap_->getData();
+    auto hx = Kokkos::create_mirror_view(x_);
+    auto hu = Kokkos::create_mirror_view(u_);
+    for (size_t n = 0; n < mesh_.numOverlapNodes(); ++n)
+      for (int i = 0; i < 3; ++i) {
+        hu(n, i) = ud[3 * n + i];
+        hx(n, i) = mesh_.X[3 * n + i] + ud[3 * n + i];
+      }
+    Kokkos::deep_copy(x_, hx);
+    Kokkos::deep_copy(u_, hu);
+  }
+  const bool tangent = W != nullptr;
+  for (auto& effect : effects_) effect->evaluate(x_, u_, tangent);
+
+  double minJ = 1e300;
+  auto elementMinJ = bricks_->minJacobian;
+  Kokkos::parallel_reduce(
+      "min J", Kokkos::RangePolicy<ExecSpace>(0, elementMinJ.extent(0)),
+      KOKKOS_LAMBDA(int e, double& m) { m = elementMinJ(e) < m ? elementMinJ(e) : m; },
+      Kokkos::Min<double>(minJ));
+  double globalMinJ = minJ;
+  Teuchos::reduceAll(*mesh_.comm, Teuchos::REDUCE_MIN, minJ, Teuchos::outArg(globalMinJ));
+  const bool valid = globalMinJ > 0 && std::isfinite(globalMinJ);
+  const auto& supportOf = constraints_.supportOf;
+
+  if (f) {
+    residual_->beginAssembly();
+    residual_->putScalar(0.0);
+    {
+      auto r = residual_->getDataNonConst(0);
+      for (const auto& effect : effects_) {
+        const auto& L = effect->local();
+        auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.dofs);
+        auto R = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.R);
+        for (size_t e = 0; e < dofs.extent(0); ++e)
+          for (size_t k = 0; k < dofs.extent(1); ++k) r[dofs(e, k)] += R(e, k);
+      }
+    }
+    residual_->endAssembly();
+    auto ro = residual_->getData(0);
+    rawOwnedResidual_.assign(ro.begin(), ro.end());
+    auto out = f->getDataNonConst();
+    for (LO d = 0; d < LO(out.size()); ++d)
+      out[d] = !valid ? 1e150 : supportOf[d] >= 0 ? 0.0 : ro[d];
+  }
+
+  if (W) {
+    W->beginAssembly();
+    W->setAllToScalar(0.0);
+    std::vector<double> vals;
+    for (size_t i = 0; i < effects_.size(); ++i) {
+      const auto& L = effects_[i]->local();
+      auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.dofs);
+      auto K = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.K);
+      const size_t n = dofs.extent(1);
+      vals.resize(n);
+      for (size_t e = 0; e < dofs.extent(0); ++e) {
+        const LO* cols = &columns_[i][e * n];
+        for (size_t k = 0; k < n; ++k) {
+          if (supportOf[dofs(e, k)] >= 0) continue;
+          for (size_t l = 0; l < n; ++l) vals[l] = supportOf[dofs(e, l)] >= 0 ? 0.0 : K(e, k, l);
+          W->sumIntoLocalValues(dofs(e, k), LO(n), vals.data(), cols);
+        }
+      }
+    }
+    const double one = 1.0;
+    const auto& colMap = *W->getColMap();
+    const auto& overlap = *mesh_.overlapDofMap;
+    for (LO d = 0; d < LO(3 * mesh_.numOwnedNodes); ++d) {
+      if (supportOf[d] < 0) continue;
+      const LO col = colMap.getLocalElement(overlap.getGlobalElement(d));
+      W->sumIntoLocalValues(d, 1, &one, &col);
+    }
+    W->endAssembly();
+  }
+  assemblySeconds_ += timer.seconds();
+  return valid;
+}
+
+std::vector<std::array<double, 3>> Assembly::constraintReactions() const {
+  const size_t ns = constraints_.supportNames.size();
+  std::vector<double> local(3 * ns, 0.0), global(3 * ns, 0.0);
+  for (size_t d = 0; d < rawOwnedResidual_.size(); ++d)
+    if (constraints_.supportOf[d] >= 0) local[3 * constraints_.supportOf[d] + d % 3] += rawOwnedResidual_[d];
+  if (ns)
+    Teuchos::reduceAll(*mesh_.comm, Teuchos::REDUCE_SUM, int(3 * ns), local.data(), global.data());
+  std::vector<std::array<double, 3>> out(ns);
+  for (size_t s = 0; s < ns; ++s) out[s] = {global[3 * s], global[3 * s + 1], global[3 * s + 2]};
+  return out;
+}
+
+}  // namespace capstan

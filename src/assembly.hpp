@@ -1,0 +1,83 @@
+// The one assembly path: every effect's per-entity residual and tangent go
+// through the same scatter into Tpetra's finite-element objects (owned plus
+// shared rows, one export per assembly), then the supports' constraints are
+// applied symmetrically.
+#pragma once
+
+#include <Tpetra_CrsMatrix.hpp>
+#include <Tpetra_FECrsGraph.hpp>
+#include <Tpetra_FECrsMatrix.hpp>
+#include <Tpetra_FEMultiVector.hpp>
+#include <Tpetra_Import.hpp>
+#include <Tpetra_Vector.hpp>
+
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "effects.hpp"
+#include "mesh.hpp"
+#include "scene.hpp"
+
+namespace capstan {
+
+using Vector = Tpetra::Vector<>;
+using CrsMatrix = Tpetra::CrsMatrix<>;
+using FEMatrix = Tpetra::FECrsMatrix<>;
+using FEGraph = Tpetra::FECrsGraph<>;
+
+// Dofs held by Fixed, Roller and Displacement supports: u = velocity * t.
+struct Constraints {
+  std::vector<std::string> supportNames;  // index = support id
+  std::vector<int> supportOf;             // per overlapped dof: support id or -1
+  std::vector<double> velocity;           // per overlapped dof
+};
+
+class Assembly {
+ public:
+  Assembly(const Mesh& mesh, const Scene& scene);
+
+  const Mesh& mesh() const { return mesh_; }
+  RCP<const Map> dofMap() const { return mesh_.ownedDofMap; }
+  RCP<FEMatrix> createMatrix() const;
+  const Constraints& constraints() const { return constraints_; }
+  BrickEffect& bricks() { return *bricks_; }
+  const std::vector<std::unique_ptr<Effect>>& effects() const { return effects_; }
+  const std::vector<FoundationEffect*>& foundations() const { return foundations_; }
+
+  // Sets the constrained entries of u to their values at time t.
+  void applyConstraints(Vector& u, double t) const;
+
+  // Runs every effect at displacement u and assembles the residual f (if not
+  // null) and the tangent W (if not null). Constrained rows: f = 0 and W has the
+  // identity in row and column (u already holds the prescribed values, so the
+  // Newton update there is zero and the elimination keeps W's structure).
+  // Returns false if an element is inverted (det F <= 0 at a Gauss point).
+  bool evaluate(const Vector& u, Vector* f, FEMatrix* W);
+
+  // Reaction force of each constrained support on the body, from the last
+  // evaluation (global sum).
+  std::vector<std::array<double, 3>> constraintReactions() const;
+  // Current positions and displacements of the overlapped nodes (last evaluation).
+  const NodalVectors& positions() const { return x_; }
+  const NodalVectors& displacements() const { return u_; }
+  double assemblySeconds() const { return assemblySeconds_; }
+
+ private:
+  const Mesh& mesh_;
+  std::vector<std::unique_ptr<Effect>> effects_;
+  BrickEffect* bricks_ = nullptr;
+  std::vector<FoundationEffect*> foundations_;
+  Constraints constraints_;
+  RCP<FEGraph> graph_;
+  std::vector<std::vector<LO>> columns_;  // per effect: [entity * dofs + k] matrix column ids
+  RCP<const Tpetra::Import<>> importer_;
+  RCP<Vector> uOverlap_;
+  RCP<Tpetra::FEMultiVector<>> residual_;
+  std::vector<double> rawOwnedResidual_;
+  NodalVectors x_, u_;
+  double assemblySeconds_ = 0;
+};
+
+}  // namespace capstan

@@ -1,0 +1,198 @@
+#include "mesh.hpp"
+
+#include <metis.h>
+#include <mpi.h>
+
+#include <Teuchos_DefaultMpiComm.hpp>
+#include <Tpetra_Map.hpp>
+
+#include <algorithm>
+#include <numeric>
+#include <stdexcept>
+#include <unordered_map>
+
+namespace capstan {
+
+// ---------------------------------------------------------------- box generator
+
+BoxGenerator::BoxGenerator(std::array<double, 3> min, std::array<double, 3> max,
+                           std::array<int, 3> cells)
+    : min_(min), max_(max), n_{cells[0], cells[1], cells[2]} {}
+
+GO BoxGenerator::numElements() const { return n_[0] * n_[1] * n_[2]; }
+GO BoxGenerator::numNodes() const { return (n_[0] + 1) * (n_[1] + 1) * (n_[2] + 1); }
+
+std::vector<std::string> BoxGenerator::faceNames() const {
+  return {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
+}
+
+std::array<GO, 3> BoxGenerator::ijk(GO e) const {
+  return {e % n_[0], (e / n_[0]) % n_[1], e / (n_[0] * n_[1])};
+}
+
+std::array<GO, 8> BoxGenerator::elementNodes(GO e) const {
+  const auto [i, j, k] = ijk(e);
+  const GO sx = n_[0] + 1, sy = n_[1] + 1;
+  auto node = [&](GO a, GO b, GO c) { return a + sx * (b + sy * c); };
+  return {node(i, j, k),         node(i + 1, j, k),         node(i + 1, j + 1, k),
+          node(i, j + 1, k),     node(i, j, k + 1),         node(i + 1, j, k + 1),
+          node(i + 1, j + 1, k + 1), node(i, j + 1, k + 1)};
+}
+
+std::array<double, 3> BoxGenerator::nodeCoordinates(GO node) const {
+  const GO sx = n_[0] + 1, sy = n_[1] + 1;
+  const GO idx[3] = {node % sx, (node / sx) % sy, node / (sx * sy)};
+  std::array<double, 3> X;
+  for (int d = 0; d < 3; ++d)
+    X[d] = idx[d] == n_[d] ? max_[d] : min_[d] + (max_[d] - min_[d]) * double(idx[d]) / double(n_[d]);
+  return X;
+}
+
+std::vector<BoundaryFace> BoxGenerator::boundaryFaces(GO e) const {
+  const auto [i, j, k] = ijk(e);
+  const auto n = elementNodes(e);
+  std::vector<BoundaryFace> f;
+  // Local node lists ordered so that the normal points out of the box.
+  if (i == 0) f.push_back({"xmin", {n[0], n[4], n[7], n[3]}});
+  if (i == n_[0] - 1) f.push_back({"xmax", {n[1], n[2], n[6], n[5]}});
+  if (j == 0) f.push_back({"ymin", {n[0], n[1], n[5], n[4]}});
+  if (j == n_[1] - 1) f.push_back({"ymax", {n[3], n[7], n[6], n[2]}});
+  if (k == 0) f.push_back({"zmin", {n[0], n[3], n[2], n[1]}});
+  if (k == n_[2] - 1) f.push_back({"zmax", {n[4], n[5], n[6], n[7]}});
+  return f;
+}
+
+std::vector<GO> BoxGenerator::faceNeighbours(GO e) const {
+  const auto c = ijk(e);
+  std::vector<GO> nb;
+  for (int d = 0; d < 3; ++d)
+    for (int s : {-1, 1}) {
+      auto m = c;
+      m[d] += s;
+      if (m[d] < 0 || m[d] >= n_[d]) continue;
+      nb.push_back(m[0] + n_[0] * (m[1] + n_[1] * m[2]));
+    }
+  return nb;
+}
+
+// ---------------------------------------------------------------- distribution
+
+namespace {
+
+MPI_Comm rawComm(const RCP<const Comm>& comm) {
+  auto mpi = Teuchos::rcp_dynamic_cast<const Teuchos::MpiComm<int>>(comm);
+  return mpi.is_null() ? MPI_COMM_SELF : (*mpi->getRawMpiComm())();
+}
+
+// Rank 0: part[e] for every element (METIS k-way on the dual graph).
+std::vector<idx_t> partitionElements(const MeshGenerator& gen, int nparts) {
+  const GO ne = gen.numElements();
+  std::vector<idx_t> part(ne, 0);
+  if (nparts == 1) return part;
+  if (ne < nparts) throw std::runtime_error("mesh: fewer elements than MPI ranks");
+  std::vector<idx_t> xadj(ne + 1, 0), adjncy;
+  for (GO e = 0; e < ne; ++e) {
+    for (GO nb : gen.faceNeighbours(e)) adjncy.push_back(idx_t(nb));
+    xadj[e + 1] = idx_t(adjncy.size());
+  }
+  idx_t n = idx_t(ne), ncon = 1, np = nparts, objval = 0;
+  idx_t options[METIS_NOPTIONS];
+  METIS_SetDefaultOptions(options);
+  options[METIS_OPTION_SEED] = 1;  // reproducible partitions
+  const int status = METIS_PartGraphKway(&n, &ncon, xadj.data(), adjncy.data(), nullptr, nullptr,
+                                         nullptr, &np, nullptr, nullptr, options, &objval,
+                                         part.data());
+  if (status != METIS_OK) throw std::runtime_error("mesh: METIS partitioning failed");
+  // METIS may leave a part empty on tiny meshes: then fall back to blocks of
+  // consecutive elements, so every rank has work.
+  std::vector<GO> size(nparts, 0);
+  for (idx_t p : part) ++size[p];
+  if (*std::min_element(size.begin(), size.end()) == 0)
+    for (GO e = 0; e < ne; ++e) part[e] = idx_t(e * nparts / ne);
+  return part;
+}
+
+// Each rank receives the global ids of its elements, in increasing order.
+std::vector<GO> scatterElements(const MeshGenerator& gen, const RCP<const Comm>& comm) {
+  const int nranks = comm->getSize(), rank = comm->getRank();
+  MPI_Comm mc = rawComm(comm);
+  std::vector<long long> sendbuf;
+  std::vector<int> counts(nranks, 0), displs(nranks, 0);
+  if (rank == 0) {
+    const auto part = partitionElements(gen, nranks);
+    for (idx_t p : part) ++counts[p];
+    std::partial_sum(counts.begin(), counts.end() - 1, displs.begin() + 1);
+    sendbuf.resize(part.size());
+    auto next = displs;
+    for (size_t e = 0; e < part.size(); ++e) sendbuf[next[part[e]]++] = (long long)e;
+  }
+  int mine = 0;
+  MPI_Scatter(counts.data(), 1, MPI_INT, &mine, 1, MPI_INT, 0, mc);
+  std::vector<long long> recv(mine);
+  MPI_Scatterv(sendbuf.data(), counts.data(), displs.data(), MPI_LONG_LONG, recv.data(), mine,
+               MPI_LONG_LONG, 0, mc);
+  return std::vector<GO>(recv.begin(), recv.end());
+}
+
+RCP<const Map> dofMap(const std::vector<GO>& nodes, const RCP<const Comm>& comm) {
+  std::vector<GO> dofs(3 * nodes.size());
+  for (size_t n = 0; n < nodes.size(); ++n)
+    for (int c = 0; c < 3; ++c) dofs[3 * n + c] = 3 * nodes[n] + c;
+  const auto invalid = Teuchos::OrdinalTraits<Tpetra::global_size_t>::invalid();
+  return rcp(new Map(invalid, Teuchos::ArrayView<const GO>(dofs), 0, comm));
+}
+
+}  // namespace
+
+Mesh distributeMesh(const MeshGenerator& gen, const RCP<const Comm>& comm) {
+  Mesh m;
+  m.comm = comm;
+  m.numGlobalNodes = gen.numNodes();
+  m.numGlobalElements = gen.numElements();
+  m.faceNames = gen.faceNames();
+  m.elementGids = scatterElements(gen, comm);
+
+  // Nodes this rank touches; ownership decided by Tpetra (one owner per node).
+  std::vector<GO> touched;
+  for (GO e : m.elementGids)
+    for (GO n : gen.elementNodes(e)) touched.push_back(n);
+  std::sort(touched.begin(), touched.end());
+  touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+  const auto invalid = Teuchos::OrdinalTraits<Tpetra::global_size_t>::invalid();
+  RCP<const Map> touchedMap = rcp(new Map(invalid, Teuchos::ArrayView<const GO>(touched), 0, comm));
+  m.ownedNodeMap = Tpetra::createOneToOne(touchedMap);
+
+  // Overlapped order: owned nodes first, then ghosts (sorted).
+  const auto owned = m.ownedNodeMap->getNodeElementList();
+  m.nodeGids.assign(owned.begin(), owned.end());
+  m.numOwnedNodes = m.nodeGids.size();
+  for (GO n : touched)
+    if (!m.ownedNodeMap->isNodeGlobalElement(n)) m.nodeGids.push_back(n);
+  m.overlapNodeMap = rcp(new Map(invalid, Teuchos::ArrayView<const GO>(m.nodeGids), 0, comm));
+  m.ownedDofMap = dofMap(std::vector<GO>(owned.begin(), owned.end()), comm);
+  m.overlapDofMap = dofMap(m.nodeGids, comm);
+
+  std::unordered_map<GO, int> lid;
+  for (size_t n = 0; n < m.nodeGids.size(); ++n) lid[m.nodeGids[n]] = int(n);
+  m.X.resize(3 * m.nodeGids.size());
+  for (size_t n = 0; n < m.nodeGids.size(); ++n) {
+    const auto X = gen.nodeCoordinates(m.nodeGids[n]);
+    for (int d = 0; d < 3; ++d) m.X[3 * n + d] = X[d];
+  }
+  for (const auto& name : m.faceNames) m.faces[name];
+  for (GO e : m.elementGids) {
+    for (GO n : gen.elementNodes(e)) m.connectivity.push_back(lid.at(n));
+    for (const auto& f : gen.boundaryFaces(e))
+      for (GO n : f.nodes) m.faces[f.name].push_back(lid.at(n));
+  }
+  return m;
+}
+
+std::vector<int> Mesh::faceNodes(const std::string& face) const {
+  std::vector<int> nodes = faces.at(face);
+  std::sort(nodes.begin(), nodes.end());
+  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  return nodes;
+}
+
+}  // namespace capstan

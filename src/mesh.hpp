@@ -1,0 +1,80 @@
+// The body's mesh as one rank sees it, and the generators that build it.
+//
+// A generator answers questions about single elements by global id (its nodes,
+// their coordinates, its boundary faces), so each rank builds only its own part:
+// the whole mesh never lives on one rank. Rank 0 partitions the element dual
+// graph with METIS (the graph only: about 7 integers per element).
+#pragma once
+
+#include <array>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "types.hpp"
+
+namespace capstan {
+
+// A boundary face of an element: 4 node ids, counter-clockwise seen from outside.
+struct BoundaryFace {
+  std::string name;
+  std::array<GO, 4> nodes;
+};
+
+class MeshGenerator {
+ public:
+  virtual ~MeshGenerator() = default;
+  virtual GO numElements() const = 0;
+  virtual GO numNodes() const = 0;
+  virtual std::vector<std::string> faceNames() const = 0;
+  virtual std::array<GO, 8> elementNodes(GO element) const = 0;
+  virtual std::array<double, 3> nodeCoordinates(GO node) const = 0;
+  virtual std::vector<BoundaryFace> boundaryFaces(GO element) const = 0;
+  // Elements sharing a face with `element` (the dual graph).
+  virtual std::vector<GO> faceNeighbours(GO element) const = 0;
+};
+
+// Structured box: Cells = {nx, ny, nz} bricks over [Min, Max]; faces xmin..zmax.
+class BoxGenerator : public MeshGenerator {
+ public:
+  BoxGenerator(std::array<double, 3> min, std::array<double, 3> max, std::array<int, 3> cells);
+  GO numElements() const override;
+  GO numNodes() const override;
+  std::vector<std::string> faceNames() const override;
+  std::array<GO, 8> elementNodes(GO element) const override;
+  std::array<double, 3> nodeCoordinates(GO node) const override;
+  std::vector<BoundaryFace> boundaryFaces(GO element) const override;
+  std::vector<GO> faceNeighbours(GO element) const override;
+
+ private:
+  std::array<double, 3> min_, max_;
+  std::array<GO, 3> n_;
+  std::array<GO, 3> ijk(GO element) const;
+};
+
+// This rank's part of the body. Node numbering is "overlapped": the nodes this
+// rank owns come first (in owned-map order), then the ghost nodes it shares.
+struct Mesh {
+  RCP<const Comm> comm;
+  GO numGlobalNodes = 0, numGlobalElements = 0;
+  std::vector<std::string> faceNames;
+
+  std::vector<GO> nodeGids;          // overlapped order
+  size_t numOwnedNodes = 0;
+  std::vector<double> X;             // 3 per overlapped node: reference coordinates
+  std::vector<GO> elementGids;       // every element lives on exactly one rank
+  std::vector<int> connectivity;     // 8 overlapped node ids per element
+  std::map<std::string, std::vector<int>> faces;  // 4 overlapped node ids per quad
+
+  RCP<const Map> ownedNodeMap, overlapNodeMap, ownedDofMap, overlapDofMap;
+
+  size_t numElements() const { return elementGids.size(); }
+  size_t numOverlapNodes() const { return nodeGids.size(); }
+  // Overlapped node ids (sorted, unique) on a named face of this rank's elements.
+  std::vector<int> faceNodes(const std::string& face) const;
+};
+
+// Partitions the generator's elements over comm and builds this rank's part.
+Mesh distributeMesh(const MeshGenerator& generator, const RCP<const Comm>& comm);
+
+}  // namespace capstan

@@ -1,0 +1,215 @@
+#include "newton.hpp"
+
+#include <Ifpack2_Factory.hpp>
+#include <Kokkos_Timer.hpp>
+#include <NOX.H>
+#include <NOX_Observer.hpp>
+#include <NOX_Thyra.H>
+#include <NOX_Thyra_Group.H>
+#include <Stratimikos_DefaultLinearSolverBuilder.hpp>
+#include <Teuchos_AbstractFactoryStd.hpp>
+#include <Thyra_Ifpack2PreconditionerFactory.hpp>
+#include <Thyra_StateFuncModelEvaluatorBase.hpp>
+#include <Thyra_TpetraThyraWrappers.hpp>
+
+namespace capstan {
+
+namespace {
+
+using ConverterT = Thyra::TpetraOperatorVectorExtraction<double>;
+
+// R(u) and dR/du of the body for NOX, through Thyra.
+class BodyModel : public Thyra::StateFuncModelEvaluatorBase<double> {
+ public:
+  BodyModel(Assembly& assembly, RCP<Thyra::LinearOpWithSolveFactoryBase<double>> lows)
+      : assembly_(assembly), lows_(lows) {
+    space_ = Thyra::createVectorSpace<double>(assembly.dofMap());
+    Thyra::ModelEvaluatorBase::InArgsSetup<double> in;
+    in.setModelEvalDescription("capstan body");
+    in.setSupports(Thyra::ModelEvaluatorBase::IN_ARG_x);
+    inArgs_ = in;
+    Thyra::ModelEvaluatorBase::OutArgsSetup<double> out;
+    out.setModelEvalDescription("capstan body");
+    out.setSupports(Thyra::ModelEvaluatorBase::OUT_ARG_f);
+    out.setSupports(Thyra::ModelEvaluatorBase::OUT_ARG_W_op);
+    outArgs_ = out;
+    nominal_ = in;
+  }
+  void setInitialGuess(const RCP<Vector>& u) {
+    nominal_.set_x(Thyra::createVector(u, space_));
+  }
+  RCP<const Thyra::VectorSpaceBase<double>> get_x_space() const override { return space_; }
+  RCP<const Thyra::VectorSpaceBase<double>> get_f_space() const override { return space_; }
+  Thyra::ModelEvaluatorBase::InArgs<double> getNominalValues() const override { return nominal_; }
+  Thyra::ModelEvaluatorBase::InArgs<double> createInArgs() const override { return inArgs_; }
+  RCP<Thyra::LinearOpBase<double>> create_W_op() const override {
+    RCP<Tpetra::Operator<>> op = assembly_.createMatrix();
+    return Thyra::createLinearOp(op);
+  }
+  RCP<const Thyra::LinearOpWithSolveFactoryBase<double>> get_W_factory() const override {
+    return lows_;
+  }
+
+ private:
+  Thyra::ModelEvaluatorBase::OutArgs<double> createOutArgsImpl() const override { return outArgs_; }
+  void evalModelImpl(const Thyra::ModelEvaluatorBase::InArgs<double>& in,
+                     const Thyra::ModelEvaluatorBase::OutArgs<double>& out) const override {
+    auto u = ConverterT::getConstTpetraVector(in.get_x());
+    RCP<Vector> f = out.get_f().is_null() ? Teuchos::null : ConverterT::getTpetraVector(out.get_f());
+    RCP<FEMatrix> W;
+    if (!out.get_W_op().is_null())
+      W = Teuchos::rcp_dynamic_cast<FEMatrix>(ConverterT::getTpetraOperator(out.get_W_op()), true);
+    assembly_.evaluate(*u, f.get(), W.get());
+  }
+
+  Assembly& assembly_;
+  RCP<Thyra::LinearOpWithSolveFactoryBase<double>> lows_;
+  RCP<const Thyra::VectorSpaceBase<double>> space_;
+  Thyra::ModelEvaluatorBase::InArgs<double> inArgs_, nominal_;
+  Thyra::ModelEvaluatorBase::OutArgs<double> outArgs_;
+};
+
+// Records |R| after every Newton iteration.
+class History : public NOX::Observer {
+ public:
+  std::vector<double> norms;
+  void runPreSolve(const NOX::Solver::Generic&) override { norms.clear(); }
+  void runPreIterate(const NOX::Solver::Generic& s) override {
+    if (norms.empty() && s.getSolutionGroup().isF()) norms.push_back(s.getSolutionGroup().getNormF());
+  }
+  void runPostIterate(const NOX::Solver::Generic& s) override {
+    norms.push_back(s.getSolutionGroup().getNormF());
+  }
+};
+
+// capstan's solver knobs as Stratimikos parameters; the scene's Solver/Stratimikos
+// sublist is applied over them.
+Teuchos::ParameterList stratimikosParameters(const Teuchos::ParameterList& solver) {
+  Teuchos::ParameterList p("Stratimikos");
+  const std::string method = solver.get<std::string>("Linear Solver");
+  if (method == "Direct") {
+    p.set("Linear Solver Type", "Amesos2");
+    p.set("Preconditioner Type", "None");
+  } else {
+    p.set("Linear Solver Type", "Belos");
+    auto& belos = p.sublist("Linear Solver Types").sublist("Belos");
+    const std::string type = method == "CG" ? "Pseudo Block CG" : "Block GMRES";
+    belos.set("Solver Type", type);
+    auto& st = belos.sublist("Solver Types").sublist(type);
+    st.set("Convergence Tolerance", solver.get<double>("Linear Tolerance"));
+    st.set("Maximum Iterations", solver.get<int>("Max Linear Iterations"));
+    if (type == "Block GMRES") {
+      st.set("Num Blocks", 200);
+      st.set("Maximum Restarts", 20);
+    }
+    const std::string prec = solver.get<std::string>("Preconditioner");
+    if (prec == "None") {
+      p.set("Preconditioner Type", "None");
+    } else {
+      p.set("Preconditioner Type", "Ifpack2");
+      auto& ifp = p.sublist("Preconditioner Types").sublist("Ifpack2");
+      if (prec == "ILU") {
+        // ILU(k) of each rank's diagonal block (Ifpack2 filters out the
+        // off-rank columns itself): block Jacobi between ranks.
+        ifp.set("Prec Type", "RILUK");
+        ifp.sublist("Ifpack2 Settings").set("fact: iluk level-of-fill", solver.get<int>("ILU Level"));
+      } else {
+        ifp.set("Prec Type", "RELAXATION");
+        ifp.sublist("Ifpack2 Settings").set("relaxation: type", "Jacobi");
+      }
+    }
+  }
+  p.setParameters(solver.sublist("Stratimikos"));
+  return p;
+}
+
+}  // namespace
+
+struct NewtonSolver::Impl {
+  Assembly& assembly;
+  Teuchos::ParameterList solver;
+  Teuchos::ParameterList strat;
+  RCP<Thyra::LinearOpWithSolveFactoryBase<double>> lows;
+  RCP<BodyModel> model;
+  double linearSeconds = 0;
+  Impl(Assembly& a, const Teuchos::ParameterList& s) : assembly(a), solver(s) {}
+};
+
+NewtonSolver::NewtonSolver(Assembly& assembly, const Teuchos::ParameterList& solver)
+    : impl_(std::make_unique<Impl>(assembly, solver)) {
+  Stratimikos::DefaultLinearSolverBuilder builder;
+  using PrecBase = Thyra::PreconditionerFactoryBase<double>;
+  using Ifpack2Factory = Thyra::Ifpack2PreconditionerFactory<Tpetra::CrsMatrix<>>;
+  builder.setPreconditioningStrategyFactory(Teuchos::abstractFactoryStd<PrecBase, Ifpack2Factory>(),
+                                            "Ifpack2");
+  impl_->strat = stratimikosParameters(solver);
+  builder.setParameterList(Teuchos::rcp(new Teuchos::ParameterList(impl_->strat)));
+  impl_->lows = builder.createLinearSolveStrategy("");
+  impl_->model = rcp(new BodyModel(assembly, impl_->lows));
+}
+
+NewtonSolver::~NewtonSolver() = default;
+
+double NewtonSolver::linearSolveSeconds() const { return impl_->linearSeconds; }
+const Teuchos::ParameterList& NewtonSolver::linearSolverParameters() const { return impl_->strat; }
+
+NewtonResult NewtonSolver::solve(Vector& u, double tolerance) {
+  Kokkos::Timer timer;
+  const double assemblyBefore = impl_->assembly.assemblySeconds();
+  auto guess = rcp(new Vector(u, Teuchos::Copy));
+  impl_->model->setInitialGuess(guess);
+  NOX::Thyra::Vector x0(Thyra::createVector(guess, impl_->model->get_x_space()));
+  auto group = rcp(new NOX::Thyra::Group(x0, impl_->model));
+
+  auto params = Teuchos::parameterList("NOX");
+  params->set("Nonlinear Solver", "Line Search Based");
+  const std::string ls = impl_->solver.get<std::string>("Line Search");
+  auto& lsp = params->sublist("Line Search");
+  lsp.set("Method", ls);
+  if (ls == "Backtrack") lsp.sublist("Backtrack").set("Max Iters", 20);
+  auto& lin = params->sublist("Direction").sublist("Newton").sublist("Linear Solver");
+  lin.set("Tolerance", impl_->solver.get<double>("Linear Tolerance"));
+  params->sublist("Printing").set("Output Information", 0);
+  auto history = rcp(new History);
+  params->sublist("Solver Options").set<RCP<NOX::Observer>>("Observer", history);
+  params->setParameters(impl_->solver.sublist("NOX"));
+
+  auto normF = rcp(new NOX::StatusTest::NormF(tolerance));
+  auto maxIters = rcp(new NOX::StatusTest::MaxIters(impl_->solver.get<int>("Max Newton Iterations")));
+  auto finite = rcp(new NOX::StatusTest::FiniteValue);
+  auto stagnation = rcp(new NOX::StatusTest::Stagnation(5, 0.999));
+  auto tests = rcp(new NOX::StatusTest::Combo(NOX::StatusTest::Combo::OR));
+  tests->addStatusTest(finite);
+  tests->addStatusTest(normF);
+  tests->addStatusTest(maxIters);
+  tests->addStatusTest(stagnation);
+
+  NewtonResult r;
+  NOX::StatusTest::StatusType status = NOX::StatusTest::Failed;
+  try {
+    auto solver = NOX::Solver::buildSolver(group, tests, params);
+    status = solver->solve();
+    const auto& g = dynamic_cast<const NOX::Thyra::Group&>(solver->getSolutionGroup());
+    const auto& x = dynamic_cast<const NOX::Thyra::Vector&>(g.getX());
+    auto sol = ConverterT::getConstTpetraVector(x.getThyraRCPVector());
+    u.update(1.0, *sol, 0.0);
+    r.iterations = solver->getNumIterations();
+    r.residualNorm = g.getNormF();
+  } catch (const std::exception& e) {
+    r.failure = std::string("nonlinear solver error: ") + e.what();
+  }
+  auto& out = params->sublist("Direction").sublist("Newton").sublist("Linear Solver").sublist("Output");
+  r.linearIterations = out.get("Cumulative Iteration Count", 0);
+  r.residualHistory = history->norms;
+  r.converged = status == NOX::StatusTest::Converged && r.failure.empty() && std::isfinite(r.residualNorm);
+  if (!r.converged && r.failure.empty()) {
+    if (finite->getStatus() == NOX::StatusTest::Failed) r.failure = "residual is not finite (NaN/Inf)";
+    else if (maxIters->getStatus() == NOX::StatusTest::Failed) r.failure = "Newton iteration limit reached";
+    else if (stagnation->getStatus() == NOX::StatusTest::Failed) r.failure = "Newton stagnated";
+    else r.failure = "Newton did not converge (line search failed)";
+  }
+  impl_->linearSeconds += timer.seconds() - (impl_->assembly.assemblySeconds() - assemblyBefore);
+  return r;
+}
+
+}  // namespace capstan

@@ -1,0 +1,42 @@
+// Newton's method for the assembled residual: NOX (line search Newton) on a
+// Thyra model evaluator, linear solves by Stratimikos (Belos + Ifpack2, or
+// Amesos2). The only file that includes the heavy Trilinos solver headers.
+#pragma once
+
+#include <Teuchos_ParameterList.hpp>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "assembly.hpp"
+
+namespace capstan {
+
+struct NewtonResult {
+  bool converged = false;
+  int iterations = 0;
+  int linearIterations = 0;
+  double residualNorm = 0;
+  std::vector<double> residualHistory;  // |R| at the start and after each iteration
+  std::string failure;                  // why it did not converge
+};
+
+class NewtonSolver {
+ public:
+  // solver: the scene's resolved Solver sublist.
+  NewtonSolver(Assembly& assembly, const Teuchos::ParameterList& solver);
+  ~NewtonSolver();
+  // Solves R(u) = 0 from the initial guess u (updated in place) until
+  // |R| <= tolerance.
+  NewtonResult solve(Vector& u, double tolerance);
+  double linearSolveSeconds() const;
+  // The linear solver and preconditioner parameters in use (Stratimikos list).
+  const Teuchos::ParameterList& linearSolverParameters() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace capstan

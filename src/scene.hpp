@@ -1,0 +1,61 @@
+// The scene: a Teuchos XML parameter list, validated against the full list of
+// valid parameters (with defaults and doc strings), then read into plain structs.
+#pragma once
+
+#include <Teuchos_ParameterList.hpp>
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace capstan {
+
+struct MeshSpec {
+  std::string type;  // Box
+  std::array<double, 3> min{}, max{};
+  std::array<int, 3> cells{};
+};
+
+struct SupportSpec {
+  std::string name, face, type;        // type: Fixed | Roller | Foundation | Displacement
+  std::array<bool, 3> components{};    // which of x, y, z the support acts on
+  double stiffness = 0;                // Foundation
+  std::array<double, 3> velocity{};    // Displacement: u = velocity * t
+};
+
+struct CapstanSpec {
+  std::string name;
+  double radius = 0;
+  std::array<double, 3> axisPoint{}, axisDirection{}, velocity{};
+  double angularVelocity = 0;
+  std::vector<std::string> contactFaces;
+  std::string method;  // Penalty | Augmented Lagrangian
+  double penalty = 0, penetrationTolerance = 0;
+  int maxAugmentations = 0;
+  std::string frictionLaw;  // None | Tanh | Arctan | Coulomb
+  double frictionCoefficient = 0, regularization = 0;
+};
+
+struct Scene {
+  std::string file, title;
+  MeshSpec mesh;
+  double c = 1, pressurePenalty = 1e-3;
+  std::vector<SupportSpec> supports;
+  std::vector<CapstanSpec> capstans;
+  int steps = 1;
+  double stepSize = 1;
+  Teuchos::ParameterList solver;   // the resolved Solver sublist
+  std::string outputDirectory;
+  bool writeFields = true;
+  Teuchos::ParameterList resolved; // the whole scene with defaults filled in
+};
+
+// Every valid parameter with its default and doc string (`capstan params`).
+Teuchos::ParameterList validParameters();
+
+// Reads, overrides (--set PATH=VALUE), validates. Throws InputError naming the
+// file and the parameter path.
+Scene loadScene(const std::string& file, const std::vector<std::string>& sets,
+                const std::string& outputOverride);
+
+}  // namespace capstan

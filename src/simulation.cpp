@@ -1,0 +1,452 @@
+#include "simulation.hpp"
+
+#include <Teuchos_CommHelpers.hpp>
+#include <Teuchos_DefaultMpiComm.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <sstream>
+
+#include "anderson.hpp"
+#include "assembly.hpp"
+#include "errors.hpp"
+#include "field_writer.hpp"
+#include "json.hpp"
+#include "newton.hpp"
+
+namespace capstan {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+MPI_Comm rawComm(const RCP<const Comm>& comm) {
+  auto mpi = Teuchos::rcp_dynamic_cast<const Teuchos::MpiComm<int>>(comm);
+  return mpi.is_null() ? MPI_COMM_SELF : (*mpi->getRawMpiComm())();
+}
+
+struct StepRecord {
+  int step = 0;
+  double time = 0;
+  int newton = 0, linear = 0, cutbacks = 0, pressureIterations = 0;
+  double residual = 0, wall = 0, volumeChange = 0;
+  std::vector<std::pair<std::string, std::array<double, 3>>> supports;
+};
+
+// Figures of the current state, reduced over all ranks.
+struct StateFigures {
+  double vmMin = 0, vmMax = 0, pMin = 0, pMax = 0, volumeChange = 0;
+  double sMin[6] = {}, sMax[6] = {};
+  std::array<double, 3> maxDisplacement{};
+  std::vector<std::pair<std::string, std::array<double, 3>>> faceMeans;
+};
+
+void writeAtomically(const fs::path& path, const std::string& text) {
+  const fs::path tmp = path.string() + ".tmp";
+  {
+    std::ofstream out(tmp);
+    out << text;
+    if (!out) throw std::runtime_error("cannot write " + tmp.string());
+  }
+  fs::rename(tmp, path);
+}
+
+class Run {
+ public:
+  Run(const Scene& scene, const RCP<const Comm>& comm, const RunOptions& opt)
+      : scene_(scene), comm_(comm), opt_(opt), rank0_(comm->getRank() == 0), t0_(Clock::now()) {}
+
+  int execute();
+
+ private:
+  bool solveAt(double t, StepRecord& rec, std::string& failure);
+  void recordStep(StepRecord& rec);
+  StateFigures figures();
+  void writeFields(int step, double time);
+  void writeSummary(bool converged, const std::string& failure);
+  void writeHistory();
+
+  const Scene& scene_;
+  RCP<const Comm> comm_;
+  RunOptions opt_;
+  bool rank0_;
+  Clock::time_point t0_;
+  std::unique_ptr<BoxGenerator> generator_;
+  Mesh mesh_;
+  std::unique_ptr<Assembly> assembly_;
+  std::unique_ptr<NewtonSolver> newton_;
+  RCP<Vector> u_;
+  std::unique_ptr<FieldWriter> writer_;
+  std::vector<StepRecord> steps_;
+  fs::path dir_;
+  double outputSeconds_ = 0;
+  double absTolerance_ = 0;
+};
+
+bool Run::solveAt(double t, StepRecord& rec, std::string& failure) {
+  const auto& sol = scene_.solver;
+  assembly_->applyConstraints(*u_, t);
+  // Tolerance relative to the residual at this (sub)step's start.
+  Vector f(u_->getMap());
+  assembly_->evaluate(*u_, &f, nullptr);
+  const double r0 = f.norm2();
+  const double tol = std::max(sol.get<double>("Newton Relative Tolerance") * r0, absTolerance_);
+  auto& bricks = assembly_->bricks();
+  const double volTol = sol.get<double>("Volume Tolerance");
+  const int maxPressure = sol.get<int>("Max Pressure Iterations");
+  AndersonMixing mixing(sol.get<int>("Pressure Acceleration Depth"), comm_);
+  for (int it = 1; it <= maxPressure; ++it) {
+    const NewtonResult r = newton_->solve(*u_, tol);
+    rec.newton += r.iterations;
+    rec.linear += r.linearIterations;
+    rec.residual = r.residualNorm;
+    rec.pressureIterations = it;
+    if (!opt_.quiet && rank0_ && std::getenv("CAPSTAN_NEWTON_LOG")) {
+      std::printf("    newton |R|:");
+      for (double n : r.residualHistory) std::printf(" %.3e", n);
+      std::printf("  (%d linear)\n", r.linearIterations);
+    }
+    if (!r.converged) {
+      failure = r.failure;
+      return false;
+    }
+    // Refresh p(x), v at the converged state, then the anchor pbar <- p(x).
+    assembly_->evaluate(*u_, &f, nullptr);
+    double change = 0;
+    auto v = bricks.volume, V = bricks.referenceVolume;
+    Kokkos::parallel_reduce(
+        "volume change", Kokkos::RangePolicy<ExecSpace>(0, v.extent(0)),
+        KOKKOS_LAMBDA(int e, double& m) {
+          const double d = Kokkos::Experimental::fabs(v(e) / V(e) - 1);
+          m = d > m ? d : m;
+        },
+        Kokkos::Max<double>(change));
+    double global = 0;
+    Teuchos::reduceAll(*comm_, Teuchos::REDUCE_MAX, change, Teuchos::outArg(global));
+    rec.volumeChange = global;
+    if (global <= volTol) return true;
+    // Next anchor: Anderson-accelerated pbar <- p(x).
+    auto hpbar = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bricks.pressureAnchor);
+    auto hp = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bricks.pressure);
+    const auto next = mixing.next(std::vector<double>(hpbar.data(), hpbar.data() + hpbar.size()),
+                                  std::vector<double>(hp.data(), hp.data() + hp.size()));
+    for (size_t e = 0; e < next.size(); ++e) hpbar(e) = next[e];
+    Kokkos::deep_copy(bricks.pressureAnchor, hpbar);
+  }
+  failure = "pressure loop did not reach Volume Tolerance";
+  return false;
+}
+
+StateFigures Run::figures() {
+  StateFigures s;
+  auto& bricks = assembly_->bricks();
+  Matrix stress;
+  Kokkos::View<double*> mises;
+  bricks.centroidStress(assembly_->positions(), stress, mises);
+  auto hs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), stress);
+  auto hm = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mises);
+  auto hp = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bricks.pressure);
+  auto hv = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bricks.volume);
+  auto hV = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bricks.referenceVolume);
+  // Local extrema as (min, -max) pairs so one REDUCE_MIN does all of them.
+  std::vector<double> lo(18, 1e300);
+  for (size_t e = 0; e < hs.extent(0); ++e) {
+    auto upd = [&](int k, double x) {
+      lo[2 * k] = std::min(lo[2 * k], x);
+      lo[2 * k + 1] = std::min(lo[2 * k + 1], -x);
+    };
+    for (int k = 0; k < 6; ++k) upd(k, hs(e, k));
+    upd(6, hm(e));
+    upd(7, hp(e));
+    lo[16] = std::min(lo[16], -std::fabs(hv(e) / hV(e) - 1));
+  }
+  std::vector<double> gl(18);
+  Teuchos::reduceAll(*comm_, Teuchos::REDUCE_MIN, 18, lo.data(), gl.data());
+  for (int k = 0; k < 6; ++k) s.sMin[k] = gl[2 * k], s.sMax[k] = -gl[2 * k + 1];
+  s.vmMin = gl[12], s.vmMax = -gl[13], s.pMin = gl[14], s.pMax = -gl[15];
+  s.volumeChange = -gl[16];
+
+  auto ud = u_->getData();
+  double md[3] = {0, 0, 0}, gmd[3];
+  for (size_t n = 0; n < mesh_.numOwnedNodes; ++n)
+    for (int i = 0; i < 3; ++i) md[i] = std::max(md[i], std::fabs(ud[3 * n + i]));
+  Teuchos::reduceAll(*comm_, Teuchos::REDUCE_MAX, 3, md, gmd);
+  s.maxDisplacement = {gmd[0], gmd[1], gmd[2]};
+
+  for (const auto& face : mesh_.faceNames) {
+    double sum[4] = {0, 0, 0, 0}, gsum[4];
+    for (int n : mesh_.faceNodes(face)) {
+      if (n >= int(mesh_.numOwnedNodes)) continue;
+      for (int i = 0; i < 3; ++i) sum[i] += ud[3 * n + i];
+      sum[3] += 1;
+    }
+    Teuchos::reduceAll(*comm_, Teuchos::REDUCE_SUM, 4, sum, gsum);
+    s.faceMeans.push_back({face, {gsum[0] / gsum[3], gsum[1] / gsum[3], gsum[2] / gsum[3]}});
+  }
+  return s;
+}
+
+void Run::recordStep(StepRecord& rec) {
+  const auto reactions = assembly_->constraintReactions();
+  std::map<std::string, std::array<double, 3>> byName;
+  for (size_t s = 0; s < reactions.size(); ++s)
+    byName[assembly_->constraints().supportNames[s]] = reactions[s];
+  for (auto* f : assembly_->foundations()) {
+    const auto local = f->localForceOnBody();
+    double g[3];
+    Teuchos::reduceAll(*comm_, Teuchos::REDUCE_SUM, 3, local.data(), g);
+    byName[f->name().substr(std::string("foundation:").size())] = {g[0], g[1], g[2]};
+  }
+  for (const auto& s : scene_.supports) rec.supports.push_back({s.name, byName[s.name]});
+}
+
+void Run::writeFields(int step, double time) {
+  if (!writer_) return;
+  const auto t = Clock::now();
+  const size_t nn = mesh_.numOwnedNodes, ne = mesh_.numElements();
+  auto ud = u_->getData();
+  std::vector<double> coords(3 * nn);
+  Field disp{"displacement", 3, std::vector<double>(3 * nn)};
+  for (size_t n = 0; n < nn; ++n)
+    for (int i = 0; i < 3; ++i) {
+      disp.values[3 * n + i] = ud[3 * n + i];
+      coords[3 * n + i] = mesh_.X[3 * n + i] + ud[3 * n + i];
+    }
+  auto& bricks = assembly_->bricks();
+  Matrix stress;
+  Kokkos::View<double*> mises;
+  bricks.centroidStress(assembly_->positions(), stress, mises);
+  auto hs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), stress);
+  auto hm = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mises);
+  auto hp = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bricks.pressure);
+  Field p{"pressure", 1, std::vector<double>(ne)}, vm{"von_mises", 1, std::vector<double>(ne)};
+  Field sig{"stress", 6, std::vector<double>(6 * ne)};
+  for (size_t e = 0; e < ne; ++e) {
+    p.values[e] = hp(e);
+    vm.values[e] = hm(e);
+    for (int k = 0; k < 6; ++k) sig.values[6 * e + k] = hs(e, k);
+  }
+  writer_->writeStep(step, time, coords, {disp}, {p, vm, sig}, {});
+  outputSeconds_ += since(t);
+}
+
+void Run::writeHistory() {
+  if (!rank0_) return;
+  std::ostringstream out;
+  out << "step,time,newton_iterations,linear_iterations,cutbacks,pressure_iterations,residual_norm,"
+         "max_abs_volume_change,wall_seconds";
+  for (const auto& s : scene_.supports) out << "," << s.name << "_fx," << s.name << "_fy," << s.name << "_fz";
+  out << "\n";
+  for (const auto& r : steps_) {
+    out << r.step << "," << json::number(r.time) << "," << r.newton << "," << r.linear << ","
+        << r.cutbacks << "," << r.pressureIterations << "," << json::number(r.residual) << ","
+        << json::number(r.volumeChange) << "," << json::number(r.wall);
+    for (const auto& s : r.supports)
+      for (double x : s.second) out << "," << json::number(x);
+    out << "\n";
+  }
+  writeAtomically(dir_ / "history.csv", out.str());
+}
+
+void Run::writeSummary(bool converged, const std::string& failure) {
+  const StateFigures s = figures();
+  if (!rank0_) return;
+  using json::Object;
+  auto vec = [](const std::array<double, 3>& v) { return json::array({v[0], v[1], v[2]}); };
+  auto mm = [](double a, double b) {
+    return Object().add("min", json::number(a)).add("max", json::number(b)).str();
+  };
+  std::string stepList = "[";
+  for (size_t i = 0; i < steps_.size(); ++i) {
+    const auto& r = steps_[i];
+    Object sup;
+    for (const auto& sp : r.supports) sup.add(sp.first, Object().add("force", vec(sp.second)).str());
+    Object o;
+    o.add("step", json::number(r.step)).add("time", json::number(r.time))
+        .add("newton_iterations", json::number(r.newton))
+        .add("linear_iterations", json::number(r.linear))
+        .add("cutbacks", json::number(r.cutbacks))
+        .add("pressure_iterations", json::number(r.pressureIterations))
+        .add("residual_norm", json::number(r.residual))
+        .add("max_abs_volume_change", json::number(r.volumeChange))
+        .add("capstans", Object().str())
+        .add("supports", sup.str())
+        .add("wall_seconds", json::number(r.wall));
+    stepList += (i ? ",\n    " : "\n    ") + o.str();
+  }
+  stepList += "\n  ]";
+  const char* comp[6] = {"xx", "yy", "zz", "xy", "yz", "xz"};
+  Object stress, faces;
+  for (int k = 0; k < 6; ++k) stress.add(comp[k], mm(s.sMin[k], s.sMax[k]));
+  for (const auto& f : s.faceMeans) faces.add(f.first, vec(f.second));
+  Object fin;
+  fin.add("von_mises", mm(s.vmMin, s.vmMax)).add("stress", stress.str())
+      .add("pressure", mm(s.pMin, s.pMax))
+      .add("max_abs_volume_change", json::number(s.volumeChange))
+      .add("max_displacement", vec(s.maxDisplacement))
+      .add("node_displacement_mean", faces.str());
+  Object effects;
+  for (const auto& e : assembly_->effects())
+    effects.add(e->name(), Object().add("launches", json::number(e->launches()))
+                               .add("seconds", json::number(e->seconds())).str());
+  const double total = since(t0_);
+  Object timing;
+  timing.add("total", json::number(total))
+      .add("assembly", json::number(assembly_->assemblySeconds()))
+      .add("linear_solve", json::number(newton_->linearSolveSeconds()))
+      .add("output", json::number(outputSeconds_));
+  Object mesh;
+  mesh.add("nodes", json::number(long(mesh_.numGlobalNodes)))
+      .add("elements", json::number(long(mesh_.numGlobalElements)))
+      .add("dofs", json::number(long(3 * mesh_.numGlobalNodes)))
+      .add("contact_faces", json::number(0));
+  Object top;
+  top.add("title", json::string(scene_.title)).add("scene", json::string(scene_.file))
+      .add("version", json::string(CAPSTAN_VERSION))
+      .add("ranks", json::number(comm_->getSize()))
+      .add("converged", converged ? "true" : "false")
+      .add("failure", converged ? "null" : json::string(failure))
+      .add("mesh", mesh.str()).add("steps", stepList).add("final", fin.str())
+      .add("timing", timing.str()).add("effects", effects.str());
+  writeAtomically(dir_ / "summary.json", top.str() + "\n");
+}
+
+int Run::execute() {
+  if (!scene_.capstans.empty())
+    throw InputError(scene_.file + ": parameter 'Capstans': contact is not available in this version");
+  // Output directory: checked before any work, so bad input writes nothing.
+  dir_ = scene_.outputDirectory;
+  int dirOk = 1;
+  std::string dirError;
+  if (rank0_) {
+    std::error_code ec;
+    fs::create_directories(dir_, ec);
+    const fs::path probe = dir_ / ".capstan-write-test";
+    std::ofstream test(probe);
+    if (ec || !test) {
+      dirOk = 0;
+      dirError = ec ? ec.message() : "not writable";
+    } else {
+      test.close();
+      fs::remove(probe);
+    }
+  }
+  Teuchos::broadcast(*comm_, 0, &dirOk);
+  if (!dirOk)
+    throw InputError(scene_.file + ": parameter 'Output/Directory': cannot write to '" +
+                     dir_.string() + "'" + (dirError.empty() ? "" : ": " + dirError));
+
+  const auto& m = scene_.mesh;
+  generator_ = std::make_unique<BoxGenerator>(m.min, m.max, m.cells);
+  mesh_ = distributeMesh(*generator_, comm_);
+  assembly_ = std::make_unique<Assembly>(mesh_, scene_);
+  newton_ = std::make_unique<NewtonSolver>(*assembly_, scene_.solver);
+  u_ = rcp(new Vector(mesh_.ownedDofMap));
+  double size2 = 0;
+  for (int d = 0; d < 3; ++d) size2 = std::max(size2, std::pow(m.max[d] - m.min[d], 2));
+  absTolerance_ = scene_.solver.get<double>("Newton Absolute Tolerance");
+  if (absTolerance_ == 0) absTolerance_ = 1e-13 * scene_.c * size2;
+
+  if (scene_.writeFields) {
+    FieldLayout layout;
+    layout.comm = rawComm(comm_);
+    long long nodes = (long long)mesh_.numOwnedNodes, elems = (long long)mesh_.numElements();
+    MPI_Exscan(&nodes, &layout.nodeOffset, 1, MPI_LONG_LONG, MPI_SUM, layout.comm);
+    MPI_Exscan(&elems, &layout.elemOffset, 1, MPI_LONG_LONG, MPI_SUM, layout.comm);
+    if (comm_->getRank() == 0) layout.nodeOffset = layout.elemOffset = 0;
+    layout.nodesOwned = nodes;
+    layout.elemsOwned = elems;
+    layout.nodesGlobal = mesh_.numGlobalNodes;
+    layout.elemsGlobal = mesh_.numGlobalElements;
+    // File index of every overlapped node: owners tell the ranks that share it.
+    Tpetra::Vector<> fileId(mesh_.ownedNodeMap), fileIdOverlap(mesh_.overlapNodeMap);
+    {
+      auto d = fileId.getDataNonConst();
+      for (size_t n = 0; n < mesh_.numOwnedNodes; ++n) d[n] = double(layout.nodeOffset + (long long)n);
+    }
+    fileIdOverlap.doImport(fileId, Tpetra::Import<>(mesh_.ownedNodeMap, mesh_.overlapNodeMap), Tpetra::INSERT);
+    auto ids = fileIdOverlap.getData();
+    for (int n : mesh_.connectivity) layout.hexConnectivity.push_back((long long)ids[n]);
+    writer_ = std::make_unique<FieldWriter>(dir_.string(), layout);
+  }
+
+  const int N = scene_.steps;
+  const double dt = scene_.stepSize;
+  assembly_->evaluate(*u_, nullptr, nullptr);
+  writeFields(0, 0.0);
+  double tDone = 0;
+  std::string failure;
+  bool ok = true;
+  for (int step = 1; step <= N && ok; ++step) {
+    const auto tStep = Clock::now();
+    StepRecord rec;
+    rec.step = step;
+    rec.time = step * dt;
+    // Sub-steps: cut the increment in half on failure, grow it back after success.
+    double h = rec.time - tDone;
+    const double hMin = dt / 1024;
+    while (tDone < rec.time - 1e-12 * dt) {
+      const double tEnd = std::min(tDone + h, rec.time);
+      Vector uSaved(*u_, Teuchos::Copy);
+      Kokkos::View<double*> pSaved("pbar saved", assembly_->bricks().pressureAnchor.extent(0));
+      Kokkos::deep_copy(pSaved, assembly_->bricks().pressureAnchor);
+      std::string why;
+      if (solveAt(tEnd, rec, why)) {
+        tDone = tEnd;
+        h = std::min(2 * h, rec.time - tDone);
+        continue;
+      }
+      u_->update(1.0, uSaved, 0.0);
+      Kokkos::deep_copy(assembly_->bricks().pressureAnchor, pSaved);
+      ++rec.cutbacks;
+      h /= 2;
+      if (!opt_.quiet && rank0_)
+        std::printf("  step %d: cut back to dt = %.4g (%s)\n", step, h, why.c_str());
+      if (h < hMin) {
+        failure = "step " + std::to_string(step) + " failed at minimum step size " +
+                  Teuchos::toString(hMin) + ": " + why;
+        ok = false;
+        break;
+      }
+    }
+    if (!ok) break;
+    assembly_->evaluate(*u_, nullptr, nullptr);
+    {
+      Vector f(u_->getMap());
+      assembly_->evaluate(*u_, &f, nullptr);  // reactions at the converged state
+    }
+    recordStep(rec);
+    rec.wall = since(tStep);
+    steps_.push_back(rec);
+    writeFields(step, rec.time);
+    writeHistory();
+    if (!opt_.quiet && rank0_) {
+      std::printf("step %d/%d  t=%.4g  newton=%d  linear=%d  |R|=%.3e  dV=%.1e  max_penetration=%.3e  %.2fs\n",
+                  step, N, rec.time, rec.newton, rec.linear, rec.residual, rec.volumeChange, 0.0,
+                  since(t0_));
+      std::fflush(stdout);
+    }
+  }
+  writeHistory();
+  writeSummary(ok, failure);
+  if (!ok && rank0_) std::fprintf(stderr, "capstan: did not converge: %s\n", failure.c_str());
+  return ok ? 0 : 2;
+}
+
+}  // namespace
+
+int runScene(const Scene& scene, const RCP<const Comm>& comm, const RunOptions& options) {
+  Run run(scene, comm, options);
+  return run.execute();
+}
+
+}  // namespace capstan
