@@ -106,19 +106,9 @@ bool Assembly::evaluate(const Vector& u, Vector* f, FEMatrix* W) {
   const auto& supportOf = constraints_.supportOf;
 
   if (f) {
-    residual_->beginAssembly();
-    residual_->putScalar(0.0);
-    {
-      auto r = residual_->getDataNonConst(0);
-      for (const auto& effect : effects_) {
-        const auto& L = effect->local();
-        auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.dofs);
-        auto R = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.R);
-        for (size_t e = 0; e < dofs.extent(0); ++e)
-          for (size_t k = 0; k < dofs.extent(1); ++k) r[dofs(e, k)] += R(e, k);
-      }
-    }
-    residual_->endAssembly();
+    std::vector<Matrix> R;
+    for (const auto& effect : effects_) R.push_back(effect->local().R);
+    sumEntityVectors(R);
     auto ro = residual_->getData(0);
     rawOwnedResidual_.assign(ro.begin(), ro.end());
     auto out = f->getDataNonConst();
@@ -157,6 +147,52 @@ bool Assembly::evaluate(const Vector& u, Vector* f, FEMatrix* W) {
   }
   assemblySeconds_ += timer.seconds();
   return valid;
+}
+
+void Assembly::sumEntityVectors(const std::vector<Matrix>& values) {
+  residual_->beginAssembly();
+  residual_->putScalar(0.0);
+  {
+    auto r = residual_->getDataNonConst(0);
+    for (size_t i = 0; i < effects_.size(); ++i) {
+      auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), effects_[i]->local().dofs);
+      auto v = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), values[i]);
+      for (size_t e = 0; e < dofs.extent(0); ++e)
+        for (size_t k = 0; k < dofs.extent(1); ++k) r[dofs(e, k)] += v(e, k);
+    }
+  }
+  residual_->endAssembly();  // one export: shared rows added into their owners
+}
+
+void Assembly::tangentAction(const Vector& z, Vector& y) {
+  uOverlap_->doImport(z, *importer_, Tpetra::INSERT);
+  auto zd = uOverlap_->getData();
+  std::vector<Matrix> Kz;
+  for (const auto& effect : effects_) {
+    const auto& L = effect->local();
+    auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.dofs);
+    auto K = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.K);
+    Matrix out("K z", dofs.extent(0), dofs.extent(1));
+    auto ho = Kokkos::create_mirror_view(out);
+    for (size_t e = 0; e < dofs.extent(0); ++e)
+      for (size_t k = 0; k < dofs.extent(1); ++k) {
+        double s = 0;
+        for (size_t l = 0; l < dofs.extent(1); ++l) s += K(e, k, l) * zd[dofs(e, l)];
+        ho(e, k) = s;
+      }
+    Kokkos::deep_copy(out, ho);
+    Kz.push_back(out);
+  }
+  sumEntityVectors(Kz);
+  auto ro = residual_->getData(0);
+  auto yd = y.getDataNonConst();
+  for (LO d = 0; d < LO(yd.size()); ++d) yd[d] = ro[d];
+}
+
+void Assembly::constraintIncrement(Vector& z, double t0, double t1) const {
+  auto data = z.getDataNonConst();
+  for (LO d = 0; d < LO(data.size()); ++d)
+    data[d] = constraints_.supportOf[d] >= 0 ? constraints_.velocity[d] * (t1 - t0) : 0.0;
 }
 
 std::vector<std::array<double, 3>> Assembly::constraintReactions() const {

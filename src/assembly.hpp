@@ -56,6 +56,12 @@ class Assembly {
   // Returns false if an element is inverted (det F <= 0 at a Gauss point).
   bool evaluate(const Vector& u, Vector* f, FEMatrix* W);
 
+  // y = K z with the element tangents of the last evaluation (no constraints
+  // applied): the load a prescribed increment z causes, for the step predictor.
+  void tangentAction(const Vector& z, Vector& y);
+  // z = prescribed displacement increment from t0 to t1 (zero on free dofs).
+  void constraintIncrement(Vector& z, double t0, double t1) const;
+
   // Reaction force of each constrained support on the body, from the last
   // evaluation (global sum).
   std::vector<std::array<double, 3>> constraintReactions() const;
@@ -65,6 +71,8 @@ class Assembly {
   double assemblySeconds() const { return assemblySeconds_; }
 
  private:
+  void sumEntityVectors(const std::vector<Matrix>& values);  // into residual_ (owned)
+
   const Mesh& mesh_;
   std::vector<std::unique_ptr<Effect>> effects_;
   BrickEffect* bricks_ = nullptr;

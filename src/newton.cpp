@@ -9,6 +9,7 @@
 #include <Stratimikos_DefaultLinearSolverBuilder.hpp>
 #include <Teuchos_AbstractFactoryStd.hpp>
 #include <Thyra_Ifpack2PreconditionerFactory.hpp>
+#include <Thyra_LinearOpWithSolveFactoryHelpers.hpp>
 #include <Thyra_StateFuncModelEvaluatorBase.hpp>
 #include <Thyra_TpetraThyraWrappers.hpp>
 
@@ -84,9 +85,15 @@ class History : public NOX::Observer {
 
 // capstan's solver knobs as Stratimikos parameters; the scene's Solver/Stratimikos
 // sublist is applied over them.
-Teuchos::ParameterList stratimikosParameters(const Teuchos::ParameterList& solver) {
+Teuchos::ParameterList stratimikosParameters(const Teuchos::ParameterList& solver, long dofs, int ranks) {
   Teuchos::ParameterList p("Stratimikos");
-  const std::string method = solver.get<std::string>("Linear Solver");
+  std::string method = solver.get<std::string>("Linear Solver");
+  // Auto: a sparse direct solve is fastest and immune to the penalty's
+  // conditioning on small meshes; Krylov with ILU above that size. On several
+  // ranks Amesos2 KLU2 fails on our FECrsMatrix in Trilinos 13.2 (a singular
+  // factorization of a matrix that GMRES solves), so Auto uses GMRES there.
+  if (method == "Auto")
+    method = dofs <= solver.get<int>("Direct Solver Max Dofs") && ranks == 1 ? "Direct" : "GMRES";
   if (method == "Direct") {
     p.set("Linear Solver Type", "Amesos2");
     p.set("Preconditioner Type", "None");
@@ -142,13 +149,33 @@ NewtonSolver::NewtonSolver(Assembly& assembly, const Teuchos::ParameterList& sol
   using Ifpack2Factory = Thyra::Ifpack2PreconditionerFactory<Tpetra::CrsMatrix<>>;
   builder.setPreconditioningStrategyFactory(Teuchos::abstractFactoryStd<PrecBase, Ifpack2Factory>(),
                                             "Ifpack2");
-  impl_->strat = stratimikosParameters(solver);
+  impl_->strat = stratimikosParameters(solver, long(assembly.dofMap()->getGlobalNumElements()),
+                                       assembly.dofMap()->getComm()->getSize());
   builder.setParameterList(Teuchos::rcp(new Teuchos::ParameterList(impl_->strat)));
   impl_->lows = builder.createLinearSolveStrategy("");
   impl_->model = rcp(new BodyModel(assembly, impl_->lows));
 }
 
 NewtonSolver::~NewtonSolver() = default;
+
+int NewtonSolver::linearSolve(const RCP<FEMatrix>& W, const Vector& b, Vector& x) {
+  Kokkos::Timer timer;
+  RCP<const Tpetra::Operator<>> op = W;
+  auto space = impl_->model->get_x_space();
+  auto lows = Thyra::linearOpWithSolve(*impl_->lows, Thyra::createConstLinearOp(op));
+  auto bt = Thyra::createConstVector(Teuchos::rcpFromRef(b), space);
+  auto xt = Thyra::createVector(Teuchos::rcpFromRef(x), space);
+  int iterations = -1;
+  try {
+    const auto status = Thyra::solve<double>(*lows, Thyra::NOTRANS, *bt, xt.ptr());
+    if (status.solveStatus == Thyra::SOLVE_STATUS_CONVERGED || status.solveStatus == Thyra::SOLVE_STATUS_UNKNOWN)
+      iterations = status.extraParameters.is_null() ? 0 : status.extraParameters->get("Iteration Count", 0);
+  } catch (const std::exception&) {
+    iterations = -1;
+  }
+  impl_->linearSeconds += timer.seconds();
+  return iterations;
+}
 
 double NewtonSolver::linearSolveSeconds() const { return impl_->linearSeconds; }
 const Teuchos::ParameterList& NewtonSolver::linearSolverParameters() const { return impl_->strat; }

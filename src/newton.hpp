@@ -30,6 +30,9 @@ class NewtonSolver {
   // Solves R(u) = 0 from the initial guess u (updated in place) until
   // |R| <= tolerance.
   NewtonResult solve(Vector& u, double tolerance);
+  // One linear solve W x = b with the configured solver (x: initial guess in,
+  // solution out). Returns the Krylov iterations, or -1 if it failed.
+  int linearSolve(const RCP<FEMatrix>& W, const Vector& b, Vector& x);
   double linearSolveSeconds() const;
   // The linear solver and preconditioner parameters in use (Stratimikos list).
   const Teuchos::ParameterList& linearSolverParameters() const;

@@ -78,7 +78,10 @@ ParameterList validParameters() {
   time.set("Step Size", 1.0, "dt > 0");
 
   auto& sol = p.sublist("Solver", false, "Nonlinear and linear solvers");
-  sol.set("Linear Solver", std::string("GMRES"), "GMRES | CG | Direct (Belos GMRES, Belos CG, Amesos2 KLU2)");
+  sol.set("Linear Solver", std::string("Auto"),
+          "Auto | GMRES | CG | Direct (Belos GMRES, Belos CG, Amesos2 KLU2). Auto: Direct up to "
+          "Direct Solver Max Dofs on one rank, GMRES otherwise");
+  sol.set("Direct Solver Max Dofs", 30000, "Auto: largest problem solved directly");
   sol.set("Preconditioner", std::string("ILU"), "ILU | Jacobi | None (Ifpack2: additive Schwarz RILUK, relaxation)");
   sol.set("ILU Level", 1, "ILU: level of fill (>= 0)");
   sol.set("Linear Tolerance", 1e-10, "Relative residual of each linear solve (0 < tol < 1)");
@@ -86,6 +89,9 @@ ParameterList validParameters() {
   sol.set("Newton Relative Tolerance", 1e-10, "Converged when |R| <= this x |R| at the step's start");
   sol.set("Newton Absolute Tolerance", 0.0, "Converged when |R| <= this; 0 = 1e-13 x c x (body size)^2");
   sol.set("Max Newton Iterations", 30, "Newton iteration limit per solve");
+  sol.set("Predictor", std::string("Tangent"),
+          "Tangent (linear response to the step's prescribed increment, from the previous "
+          "step) | Previous (the previous step's solution with the new boundary values)");
   sol.set("Line Search", std::string("Backtrack"), "Backtrack | Polynomial | Full Step (NOX line search)");
   sol.set("Volume Tolerance", 1e-10, "Pressure loop ends when max |v_e/V_e - 1| is below this");
   sol.set("Max Pressure Iterations", 100, "Most pressure-anchor updates per step");
@@ -384,9 +390,10 @@ Scene loadScene(const std::string& file, const std::vector<std::string>& sets,
       v.fail("Solver/" + name, "'" + val + "' is not one of " + list);
     }
   };
-  oneOf("Linear Solver", {"GMRES", "CG", "Direct"});
+  oneOf("Linear Solver", {"Auto", "GMRES", "CG", "Direct"});
   oneOf("Preconditioner", {"ILU", "Jacobi", "None"});
   oneOf("Line Search", {"Backtrack", "Polynomial", "Full Step"});
+  oneOf("Predictor", {"Tangent", "Previous"});
   for (const char* n : {"Linear Tolerance", "Newton Relative Tolerance", "Volume Tolerance"}) {
     const double x = sol.get<double>(n);
     if (!(x > 0 && x < 1)) v.fail(std::string("Solver/") + n, "must be in (0, 1)");

@@ -1,0 +1,131 @@
+#!/usr/bin/env python3
+"""A run that cannot converge exits 2 and keeps the converged steps (interface.md:
+"2 the solve failed to converge even after step cutting (outputs of every
+converged step are kept and complete, summary.json says "converged": false and
+why)").
+
+Case A, a physically impossible load: inputs/uniaxial.xml on a 2 x 1 x 1 mesh,
+xmax pushed towards xmin at 0.5 per step for 4 steps, so the block (length 2) is
+compressed to lambda = 0.75, 0.5, 0.25 and then to zero length, which no
+incompressible body can reach. Steps 1..3 converge; step 4 must fail whatever
+the solver does.
+
+Case B, the solver settings of the task: inputs/uniaxial.xml with
+Solver/Max Newton Iterations=1 and Solver/Line Search=Full Step, which fails in
+step 1 (no converged step at all).
+
+Checks, both cases: exit status 2; summary.json has "converged": false, a
+non-empty "failure", no NaN or infinity anywhere, and passes check_summary.py;
+history.csv, fields.xmf and fields.h5 exist and hold exactly the converged
+steps (and the initial state, step 0, in the fields); summary "steps" agree with
+history.csv; and summary "final" describes the last converged state (the last
+step in fields.h5; step 0 when none converged), not the state of the failed
+attempt: max_displacement and the stress extrema equal those of that step in
+fields.h5, and max_abs_volume_change is within Solver/Volume Tolerance (1e-10).
+"""
+import csv
+import math
+import os
+import re
+import sys
+
+sys.dont_write_bytecode = True  # nothing written into the source tree
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from capstan_test import STRESS, Test, has_nan, read_fields  # noqa: E402
+
+T = Test("failure_exit2", __doc__)
+scene = T.input("uniaxial.xml")
+
+
+def common(label, sets, min_steps):
+    p, s, out = T.run_scene(scene, label, sets=sets, expect_rc=2)
+    err = p.stderr.strip().splitlines()
+    print(f"    stderr: {err[-1] if err else '(empty)'}")
+    if s is None:
+        T.fatal(f"{label}: no summary.json after a failed run")
+    T.check(s["converged"] is False, f"{label}: summary converged = {s['converged']!r} (false)")
+    T.check(isinstance(s["failure"], str) and s["failure"].strip() != "",
+            f"{label}: summary failure = {s['failure']!r} (non-empty)")
+    with open(os.path.join(out, "summary.json")) as f:
+        raw = f.read()
+    bad_tokens = re.findall(r"\b(?:NaN|nan|-?Infinity|-?inf)\b", raw)
+    T.check(not bad_tokens and not has_nan(s), f"{label}: no NaN/Infinity in summary.json (found {bad_tokens[:3]})")
+    T.conforms(out, scene)
+    nsteps = len(s["steps"])
+    T.check(nsteps >= min_steps, f"{label}: {nsteps} converged steps kept in summary.json (>= {min_steps})")
+    T.check([st["step"] for st in s["steps"]] == list(range(1, nsteps + 1)),
+            f"{label}: summary steps numbered {[st['step'] for st in s['steps']]}")
+    # history.csv: one row per converged step, the same as summary.json.
+    hp = os.path.join(out, "history.csv")
+    if T.check(os.path.isfile(hp), f"{label}: history.csv exists"):
+        with open(hp) as f:
+            rows = list(csv.DictReader(f))
+        T.check([int(r["step"]) for r in rows] == [st["step"] for st in s["steps"]],
+                f"{label}: history.csv rows {[r['step'] for r in rows]} = summary steps")
+        for r, st in zip(rows, s["steps"]):
+            T.check(math.isclose(float(r["time"]), st["time"]) and all(
+                    math.isfinite(float(v)) for k, v in r.items() if v not in (None, "")),
+                    f"{label}: history.csv step {r['step']}: time {r['time']} = {st['time']}, all values finite")
+    # fields: step 0 plus the converged steps, no more.
+    xp = os.path.join(out, "fields.xmf")
+    times = []
+    if T.check(os.path.isfile(xp), f"{label}: fields.xmf exists"):
+        with open(xp) as f:
+            xmf = f.read()
+        times = sorted({float(t) for t in re.findall(r'<Time Value="([^"]+)"', xmf)})
+        want = [0.0] + [st["time"] for st in s["steps"]]
+        T.check(len(times) == len(want) and all(math.isclose(a, b) for a, b in zip(times, want)),
+                f"{label}: fields.xmf lists times {times} (step 0 + converged steps {want})")
+    fields = None
+    try:
+        fields = read_fields(os.path.join(out, "fields.h5"))
+        T.check(sorted(fields) == list(range(0, nsteps + 1)),
+                f"{label}: fields.h5 holds steps {sorted(fields)} (0..{nsteps})")
+        finite = all(all(math.isfinite(float(x)) for x in arr.ravel())
+                     for st in fields.values() for arr in (st["u"], st["stress"], st["pressure"]))
+        T.check(finite, f"{label}: fields.h5: every stored value finite")
+    except Exception as e:  # noqa: BLE001
+        T.check(False, f"{label}: cannot read fields.h5: {e}")
+    if fields:
+        final_is_last_converged(label, s, fields)
+    return s, out, fields
+
+
+def final_is_last_converged(label, s, fields):
+    """summary "final" describes the last state written to fields.h5."""
+    import numpy as np
+    step = max(fields)
+    last = fields[step]
+    fin = s["final"]
+    umax = np.abs(last["u"]).max(axis=0)
+    scale = max(float(umax.max()), 1.0)  # 1 = the body's cross-section size
+    diff = max(abs(a - b) for a, b in zip(fin["max_displacement"], umax)) / scale
+    T.check(diff <= 1e-8, f"{label}: final.max_displacement {fin['max_displacement']} = max |u| of fields.h5 step "
+            f"{step} {[float(x) for x in umax]} (diff / scale {diff:.2e})")
+    st = last["stress"]
+    sscale = max(float(np.abs(st).max()), 1.0)  # 1 = c, the stress unit
+    worst, where = 0.0, ""
+    for k, comp in enumerate(STRESS):
+        for m, ref in (("min", st[:, k].min()), ("max", st[:, k].max())):
+            d = abs(fin["stress"][comp][m] - ref) / sscale
+            if d > worst:
+                worst, where = d, f"{comp}.{m}: final {fin['stress'][comp][m]!r}, fields.h5 {float(ref)!r}"
+    T.check(worst <= 1e-8, f"{label}: final.stress extrema = those of fields.h5 step {step} "
+            f"(worst diff / scale {worst:.2e}{'; ' + where if where else ''})")
+    dv = fin["max_abs_volume_change"]
+    T.check(dv <= 1e-10, f"{label}: final.max_abs_volume_change = {dv:.3e} (<= Volume Tolerance 1e-10: a converged state)")
+
+
+# --- Case A: compression to zero length -------------------------------------
+print("\n  --- case A: compression to zero length in 4 steps")
+sA, outA, fA = common("A-impossible", ["Mesh/Cells={2,1,1}", "Supports/pull/Velocity={-0.5,0,0}", "Time/Steps=4"],
+                      min_steps=1)
+T.check(len(sA["steps"]) < 4, f"A: the impossible step 4 is not reported as converged ({len(sA['steps'])} steps)")
+T.check("step" in sA["failure"].lower(), f"A: failure names the step: {sA['failure']!r}")
+
+# --- Case B: one full Newton step per solve ---------------------------------
+print("\n  --- case B: Max Newton Iterations=1, Line Search=Full Step")
+sB, outB, fB = common("B-one-newton", ["Solver/Max Newton Iterations=1", "Solver/Line Search=Full Step"],
+                      min_steps=0)
+
+T.finish()

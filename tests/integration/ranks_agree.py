@@ -1,0 +1,72 @@
+#!/usr/bin/env python3
+"""A distributed run gives the results of a serial one (interface.md: "mpiexec -n 2
+capstan run SCENE.xml  # distributed run, same results as one rank").
+
+inputs/uniaxial.xml and inputs/shear.xml on 1 and 2 ranks:
+  * summary.json: "ranks" is 1 and 2; both converge with the same number of steps;
+  * final stress, pressure and von Mises extrema, the face means of the
+    displacement and every support force of every step agree to 1e-8 relative to
+    the largest magnitude of their kind;
+  * fields.h5: the final displacement of every node, matched by its reference
+    coordinates (node order depends on the partition), agrees to 1e-8 x max |u|.
+"""
+import os
+import sys
+
+sys.dont_write_bytecode = True  # nothing written into the source tree
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from capstan_test import Test, by_reference_coordinates, read_fields, summary_figures  # noqa: E402
+
+TOL = 1e-8
+T = Test("ranks_agree", __doc__)
+
+for name in ("uniaxial.xml", "shear.xml"):
+    scene = T.input(name)
+    results = {}
+    for ranks in (1, 2):
+        p, s, out = T.run_scene(scene, f"{name[:-4]}-{ranks}", ranks=ranks)
+        if s is None:
+            T.check(False, f"{name} on {ranks} rank(s): no summary.json")
+            continue
+        T.check(s["ranks"] == ranks, f"{name} on {ranks} rank(s): summary ranks = {s['ranks']} ({ranks})")
+        T.check(s["converged"] is True, f"{name} on {ranks} rank(s): converged = {s['converged']} ({s['failure']!r})")
+        T.conforms(out, scene)
+        results[ranks] = (s, out)
+    if len(results) < 2:
+        continue
+    (s1, out1), (s2, out2) = results[1], results[2]
+    T.check(len(s1["steps"]) == len(s2["steps"]),
+            f"{name}: {len(s1['steps'])} steps on 1 rank, {len(s2['steps'])} on 2")
+    T.check(s1["mesh"] == s2["mesh"], f"{name}: mesh sizes {s1['mesh']} vs {s2['mesh']}")
+    g1, g2 = summary_figures(s1), summary_figures(s2)
+    for group in g1:
+        scale = max(abs(x) for x in g1[group].values())
+        missing = set(g1[group]) ^ set(g2[group])
+        if missing:
+            T.check(False, f"{name}: {group} figures present in one run only: {sorted(missing)[:5]}")
+            continue
+        diffs = {k: abs(g2[group][k] - v) / scale for k, v in g1[group].items()}
+        k = max(diffs, key=diffs.get)
+        T.check(diffs[k] <= TOL,
+                f"{name}: {group}: {len(diffs)} figures, scale {scale:.4g}, worst rel. diff {diffs[k]:.2e} "
+                f"({k}: 1 rank {g1[group][k]!r}, 2 ranks {g2[group][k]!r})")
+    # Nodal displacements, matched by reference coordinates.
+    try:
+        f1 = read_fields(os.path.join(out1, "fields.h5"))
+        f2 = read_fields(os.path.join(out2, "fields.h5"))
+    except Exception as e:  # noqa: BLE001
+        T.check(False, f"{name}: cannot read fields.h5: {e}")
+        continue
+    T.check(sorted(f1) == sorted(f2), f"{name}: fields.h5 steps {sorted(f1)} vs {sorted(f2)}")
+    last = max(f1)
+    u1 = by_reference_coordinates(f1[last]["X"], f1[last]["u"])
+    u2 = by_reference_coordinates(f2[last]["X"], f2[last]["u"])
+    T.check(len(u1) == len(f1[last]["X"]) and set(u1) == set(u2),
+            f"{name}: {len(u1)} nodes on 1 rank, {len(u2)} on 2, same reference coordinates: {set(u1) == set(u2)}")
+    if set(u1) == set(u2):
+        umax = max(abs(x) for v in u1.values() for x in v)
+        worst = max(abs(a - b) for key in u1 for a, b in zip(u1[key], u2[key])) / umax
+        T.check(worst <= TOL, f"{name}: fields.h5 step {last}: nodal displacement, {len(u1)} nodes, "
+                f"max |u| = {umax:.4g}, worst diff / max |u| = {worst:.2e}")
+
+T.finish()

@@ -1,0 +1,490 @@
+// Scene loading and validation (interface.md, "Scene file" and "Command line"):
+// every bad input throws capstan::InputError whose message names the scene file and
+// the parameter path; good input loads with defaults filled in, --set overrides a
+// parameter by its path, and --output overrides Output/Directory.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "errors.hpp"
+#include "scene.hpp"
+
+using namespace capstan;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A temporary directory for the scene files, removed after the suite.
+class SceneTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = fs::temp_directory_path() / ("capstan-test-scene-" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+  }
+  static void TearDownTestSuite() {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+
+  // Writes TEXT to a fresh file named after the running test and returns its path.
+  static std::string write(const std::string& text, const std::string& suffix = ".xml") {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    const fs::path p = dir_ / (std::string(info->name()) + "_" + std::to_string(counter_++) + suffix);
+    std::ofstream out(p, std::ios::binary);
+    out << text;
+    return p.string();
+  }
+
+  static fs::path dir_;
+  static int counter_;
+};
+
+fs::path SceneTest::dir_;
+int SceneTest::counter_ = 0;
+
+// A complete, valid scene; the pieces can be replaced to make it bad.
+struct SceneText {
+  std::string title = R"X(<Parameter name="Title" type="string" value="test scene"/>)X";
+  std::string mesh = R"X(
+  <ParameterList name="Mesh">
+    <Parameter name="Type"  type="string"        value="Box"/>
+    <Parameter name="Min"   type="Array(double)" value="{0, 0, 0}"/>
+    <Parameter name="Max"   type="Array(double)" value="{2, 1, 1}"/>
+    <Parameter name="Cells" type="Array(int)"    value="{4, 2, 2}"/>
+  </ParameterList>)X";
+  std::string material = R"X(
+  <ParameterList name="Material">
+    <Parameter name="c" type="double" value="1"/>
+    <Parameter name="Pressure Penalty" type="double" value="1e-3"/>
+  </ParameterList>)X";
+  std::string supports = R"X(
+  <ParameterList name="Supports">
+    <ParameterList name="base">
+      <Parameter name="Face" type="string" value="ymin"/>
+      <Parameter name="Type" type="string" value="Fixed"/>
+    </ParameterList>
+    <ParameterList name="pull">
+      <Parameter name="Face" type="string" value="xmax"/>
+      <Parameter name="Type" type="string" value="Displacement"/>
+      <Parameter name="Components" type="string" value="x"/>
+      <Parameter name="Velocity" type="Array(double)" value="{0.2, 0, 0}"/>
+    </ParameterList>
+    <ParameterList name="wall">
+      <Parameter name="Face" type="string" value="xmin"/>
+      <Parameter name="Type" type="string" value="Foundation"/>
+      <Parameter name="Components" type="string" value="x"/>
+      <Parameter name="Stiffness" type="double" value="1"/>
+    </ParameterList>
+  </ParameterList>)X";
+  std::string time = R"X(
+  <ParameterList name="Time">
+    <Parameter name="Steps"     type="int"    value="5"/>
+    <Parameter name="Step Size" type="double" value="1"/>
+  </ParameterList>)X";
+  std::string solver = R"X(
+  <ParameterList name="Solver">
+    <Parameter name="Linear Solver" type="string" value="GMRES"/>
+  </ParameterList>)X";
+  std::string output = R"X(
+  <ParameterList name="Output">
+    <Parameter name="Directory" type="string" value="out/test"/>
+  </ParameterList>)X";
+
+  std::string str() const {
+    return "<ParameterList name=\"Scene\">\n  " + title + mesh + material + supports + time + solver +
+           output + "\n</ParameterList>\n";
+  }
+};
+
+// Replaces the first occurrence of FROM in TEXT by TO (FROM must be there).
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << "test bug: '" << from << "' not in the scene";
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return text;
+}
+
+// Loads FILE and expects an InputError whose message contains the file name and
+// every one of NEEDLES (the parameter path, and what is wrong where given).
+void expectInputError(const std::string& file, const std::vector<std::string>& needles,
+                      const std::vector<std::string>& sets = {}, const std::string& output = "") {
+  try {
+    loadScene(file, sets, output);
+    ADD_FAILURE() << "no InputError for " << file << " (expected one naming " << needles.front() << ")";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(file), std::string::npos) << "message does not name the file " << file << ":\n  " << what;
+    for (const auto& n : needles)
+      EXPECT_NE(what.find(n), std::string::npos) << "message does not contain '" << n << "':\n  " << what;
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "expected capstan::InputError, got another exception: " << e.what();
+  }
+}
+
+// The valid scene with FROM replaced by TO.
+std::string sceneWith(const std::string& from, const std::string& to) {
+  return replaced(SceneText().str(), from, to);
+}
+
+// ---------------------------------------------------------------------------
+// The file itself
+
+TEST_F(SceneTest, ValidSceneLoads) {
+  const std::string file = write(SceneText().str());
+  const Scene s = loadScene(file, {}, "");
+  EXPECT_EQ(s.file, file);
+  EXPECT_EQ(s.title, "test scene");
+  EXPECT_EQ(s.mesh.type, "Box");
+  EXPECT_EQ(s.mesh.cells, (std::array<int, 3>{4, 2, 2}));
+  EXPECT_EQ(s.mesh.max, (std::array<double, 3>{2, 1, 1}));
+  EXPECT_EQ(s.c, 1.0);
+  EXPECT_EQ(s.pressurePenalty, 1e-3);
+  EXPECT_EQ(s.steps, 5);
+  EXPECT_EQ(s.stepSize, 1.0);
+  EXPECT_EQ(s.outputDirectory, "out/test");
+  ASSERT_EQ(s.supports.size(), 3u);
+  EXPECT_EQ(s.supports[0].name, "base");
+  EXPECT_EQ(s.supports[0].components, (std::array<bool, 3>{true, true, true}));
+  EXPECT_EQ(s.supports[1].name, "pull");
+  EXPECT_EQ(s.supports[1].type, "Displacement");
+  EXPECT_EQ(s.supports[1].components, (std::array<bool, 3>{true, false, false}));
+  EXPECT_EQ(s.supports[1].velocity, (std::array<double, 3>{0.2, 0, 0}));
+  EXPECT_EQ(s.supports[2].type, "Foundation");
+  EXPECT_EQ(s.supports[2].stiffness, 1.0);
+  EXPECT_TRUE(s.capstans.empty());
+}
+
+TEST_F(SceneTest, DefaultsAreFilledIn) {
+  // Only the mesh and one support given: everything else takes its default.
+  const std::string file = write(R"X(<ParameterList name="Scene">
+  <ParameterList name="Mesh">
+    <Parameter name="Cells" type="Array(int)" value="{2, 3, 4}"/>
+  </ParameterList>
+  <ParameterList name="Material">
+    <Parameter name="c" type="double" value="3"/>
+  </ParameterList>
+  <ParameterList name="Supports">
+    <ParameterList name="roll">
+      <Parameter name="Face" type="string" value="zmin"/>
+      <Parameter name="Type" type="string" value="Roller"/>
+    </ParameterList>
+  </ParameterList>
+</ParameterList>
+)X");
+  const Scene s = loadScene(file, {}, "");
+  const auto valid = validParameters();
+  EXPECT_EQ(s.title, "");
+  EXPECT_EQ(s.mesh.type, "Box");
+  EXPECT_EQ(s.mesh.min, (std::array<double, 3>{0, 0, 0}));
+  EXPECT_EQ(s.mesh.max, (std::array<double, 3>{1, 1, 1}));
+  EXPECT_EQ(s.mesh.cells, (std::array<int, 3>{2, 3, 4}));
+  EXPECT_EQ(s.c, 3.0);
+  EXPECT_EQ(s.pressurePenalty, valid.sublist("Material").get<double>("Pressure Penalty"));
+  EXPECT_EQ(s.steps, valid.sublist("Time").get<int>("Steps"));
+  EXPECT_EQ(s.stepSize, valid.sublist("Time").get<double>("Step Size"));
+  EXPECT_EQ(s.outputDirectory, valid.sublist("Output").get<std::string>("Directory"));
+  EXPECT_TRUE(s.writeFields);
+  ASSERT_EQ(s.supports.size(), 1u);
+  EXPECT_EQ(s.supports[0].components, (std::array<bool, 3>{true, true, true}))
+      << "a Roller without Components takes the default \"xyz\"";
+  // The resolved lists hold every parameter of the valid list.
+  const auto& sol = s.resolved.sublist("Solver");
+  for (const char* n : {"Linear Solver", "Preconditioner", "Line Search"})
+    EXPECT_EQ(sol.get<std::string>(n), valid.sublist("Solver").get<std::string>(n)) << n;
+  for (const char* n : {"Linear Tolerance", "Newton Relative Tolerance", "Volume Tolerance",
+                        "Minimum Solve Penalty"})
+    EXPECT_EQ(sol.get<double>(n), valid.sublist("Solver").get<double>(n)) << n;
+  EXPECT_EQ(sol.get<int>("Max Newton Iterations"), valid.sublist("Solver").get<int>("Max Newton Iterations"));
+  EXPECT_TRUE(s.resolved.sublist("Material").isParameter("Model"));
+  EXPECT_EQ(s.resolved.sublist("Supports").sublist("roll").get<std::string>("Components"), "xyz");
+}
+
+TEST_F(SceneTest, IntAcceptedForDouble) {
+  std::string text = SceneText().str();
+  text = replaced(text, R"X(<Parameter name="c" type="double" value="1"/>)X",
+                  R"X(<Parameter name="c" type="int" value="2"/>)X");
+  text = replaced(text, R"X(<Parameter name="Step Size" type="double" value="1"/>)X",
+                  R"X(<Parameter name="Step Size" type="int" value="3"/>)X");
+  text = replaced(text, R"X(<Parameter name="Max"   type="Array(double)" value="{2, 1, 1}"/>)X",
+                  R"X(<Parameter name="Max"   type="Array(int)" value="{3, 2, 1}"/>)X");
+  const Scene s = loadScene(write(text), {}, "");
+  EXPECT_EQ(s.c, 2.0);
+  EXPECT_EQ(s.stepSize, 3.0);
+  EXPECT_EQ(s.mesh.max, (std::array<double, 3>{3, 2, 1}));
+  EXPECT_EQ(s.resolved.sublist("Material").get<double>("c"), 2.0);
+}
+
+TEST_F(SceneTest, MalformedXml) {
+  // Unclosed element.
+  const std::string f1 = write("<ParameterList name=\"Scene\">\n  <ParameterList name=\"Mesh\">\n</ParameterList>\n");
+  expectInputError(f1, {"XML"});
+  // Truncated in the middle of a tag.
+  std::string full = SceneText().str();
+  const std::string f2 = write(full.substr(0, full.size() / 2));
+  expectInputError(f2, {"XML"});
+  // Not XML at all.
+  const std::string f3 = write("Mesh/Cells = {4, 2, 2}\n");
+  expectInputError(f3, {});
+}
+
+TEST_F(SceneTest, EmptyFile) {
+  expectInputError(write(""), {"empty"});
+  expectInputError(write("  \n\t\n"), {"empty"});
+}
+
+TEST_F(SceneTest, BinaryGarbage) {
+  std::string garbage;
+  for (int i = 0; i < 512; ++i) garbage += char((i * 37 + 11) % 256);
+  expectInputError(write(garbage, ".bin"), {});
+  // Binary data after a valid start.
+  expectInputError(write(std::string("<ParameterList name=\"Scene\">\x01\x02\x00\x7f", 32)), {});
+}
+
+TEST_F(SceneTest, MissingFile) {
+  const std::string file = (dir_ / "no-such-scene.xml").string();
+  expectInputError(file, {});
+}
+
+// ---------------------------------------------------------------------------
+// Names and types
+
+TEST_F(SceneTest, UnknownParameter) {
+  expectInputError(write(sceneWith(R"X(<Parameter name="Cells" )X", R"X(<Parameter name="Cels" )X")),
+                   {"Mesh/Cels", "unknown"});
+  expectInputError(write(sceneWith(R"X(<Parameter name="c" )X", R"X(<Parameter name="C" )X")), {"Material/C"});
+  // An unknown top-level parameter.
+  expectInputError(write(sceneWith(R"X(<Parameter name="Title" )X", R"X(<Parameter name="Titel" )X")), {"Titel"});
+  // An unknown parameter inside a named support.
+  expectInputError(write(sceneWith(R"X(<Parameter name="Stiffness" )X", R"X(<Parameter name="Stifness" )X")),
+                   {"Supports/wall/Stifness"});
+}
+
+TEST_F(SceneTest, MisspelledSublist) {
+  expectInputError(write(sceneWith(R"X(<ParameterList name="Material">)X", R"X(<ParameterList name="Materail">)X")),
+                   {"Materail"});
+  expectInputError(write(sceneWith(R"X(<ParameterList name="Supports">)X", R"X(<ParameterList name="Support">)X")),
+                   {"Support"});
+  expectInputError(write(sceneWith(R"X(<ParameterList name="Solver">)X",
+                                   R"X(<ParameterList name="Solver"><ParameterList name="Belos"></ParameterList>)X")),
+                   {"Solver/Belos"});
+  // A sublist where a parameter belongs.
+  expectInputError(write(sceneWith(R"X(<Parameter name="Title" type="string" value="test scene"/>)X",
+                                   R"X(<ParameterList name="Title"></ParameterList>)X")),
+                   {"Title"});
+}
+
+TEST_F(SceneTest, WrongType) {
+  expectInputError(write(sceneWith(R"X(<Parameter name="c" type="double" value="1"/>)X",
+                                   R"X(<Parameter name="c" type="string" value="one"/>)X")),
+                   {"Material/c"});
+  expectInputError(write(sceneWith(R"X(<Parameter name="c" type="double" value="1"/>)X",
+                                   R"X(<Parameter name="c" type="string" value="1"/>)X")),
+                   {"Material/c"});
+  expectInputError(write(sceneWith(R"X(<Parameter name="Steps"     type="int"    value="5"/>)X",
+                                   R"X(<Parameter name="Steps"     type="double" value="5.5"/>)X")),
+                   {"Time/Steps"});
+  expectInputError(write(sceneWith(R"X(<Parameter name="Cells" type="Array(int)"    value="{4, 2, 2}"/>)X",
+                                   R"X(<Parameter name="Cells" type="Array(double)" value="{4, 2, 2}"/>)X")),
+                   {"Mesh/Cells"});
+  expectInputError(write(sceneWith(R"X(<Parameter name="Face" type="string" value="ymin"/>)X",
+                                   R"X(<Parameter name="Face" type="int" value="3"/>)X")),
+                   {"Supports/base/Face"});
+}
+
+// ---------------------------------------------------------------------------
+// Values
+
+TEST_F(SceneTest, CellsMustBePositive) {
+  const std::string from = R"X(value="{4, 2, 2}")X";
+  for (const char* bad : {"{0, 2, 2}", "{4, 0, 2}", "{4, 2, 0}", "{-1, 2, 2}", "{4, 2, -3}"})
+    expectInputError(write(sceneWith(from, std::string("value=\"") + bad + "\"")), {"Mesh/Cells"});
+}
+
+TEST_F(SceneTest, CellsNeedThreeEntries) {
+  const std::string from = R"X(value="{4, 2, 2}")X";
+  expectInputError(write(sceneWith(from, R"X(value="{4, 2}")X")), {"Mesh/Cells"});
+  expectInputError(write(sceneWith(from, R"X(value="{4, 2, 2, 2}")X")), {"Mesh/Cells"});
+  expectInputError(write(sceneWith(R"X(value="{2, 1, 1}")X", R"X(value="{2, 1}")X")), {"Mesh/Max"});
+}
+
+TEST_F(SceneTest, MaxMustExceedMin) {
+  const std::string from = R"X(value="{2, 1, 1}")X";
+  expectInputError(write(sceneWith(from, R"X(value="{2, 0, 1}")X")), {"Mesh/Max"});    // equal
+  expectInputError(write(sceneWith(from, R"X(value="{-1, 1, 1}")X")), {"Mesh/Max"});   // below
+  expectInputError(write(sceneWith(from, R"X(value="{2, 1, -0.5}")X")), {"Mesh/Max"});
+}
+
+TEST_F(SceneTest, MaterialConstantPositive) {
+  const std::string from = R"X(<Parameter name="c" type="double" value="1"/>)X";
+  for (const char* bad : {"0", "-1", "-1e-12"})
+    expectInputError(write(sceneWith(from, std::string(R"X(<Parameter name="c" type="double" value=")X") + bad + "\"/>")),
+                     {"Material/c"});
+}
+
+TEST_F(SceneTest, PressurePenaltyPositive) {
+  const std::string from = R"X(<Parameter name="Pressure Penalty" type="double" value="1e-3"/>)X";
+  for (const char* bad : {"0", "-1e-3"})
+    expectInputError(
+        write(sceneWith(from, std::string(R"X(<Parameter name="Pressure Penalty" type="double" value=")X") + bad + "\"/>")),
+        {"Material/Pressure Penalty"});
+}
+
+TEST_F(SceneTest, TimeStepsAtLeastOne) {
+  const std::string from = R"X(<Parameter name="Steps"     type="int"    value="5"/>)X";
+  expectInputError(write(sceneWith(from, R"X(<Parameter name="Steps" type="int" value="0"/>)X")), {"Time/Steps"});
+  expectInputError(write(sceneWith(from, R"X(<Parameter name="Steps" type="int" value="-2"/>)X")), {"Time/Steps"});
+}
+
+TEST_F(SceneTest, StepSizePositive) {
+  const std::string from = R"X(<Parameter name="Step Size" type="double" value="1"/>)X";
+  expectInputError(write(sceneWith(from, R"X(<Parameter name="Step Size" type="double" value="0"/>)X")),
+                   {"Time/Step Size"});
+  expectInputError(write(sceneWith(from, R"X(<Parameter name="Step Size" type="double" value="-0.1"/>)X")),
+                   {"Time/Step Size"});
+}
+
+TEST_F(SceneTest, UnknownSupportType) {
+  expectInputError(write(sceneWith(R"X(<Parameter name="Type" type="string" value="Fixed"/>)X",
+                                   R"X(<Parameter name="Type" type="string" value="Clamped"/>)X")),
+                   {"Supports/base/Type", "Clamped"});
+  expectInputError(write(sceneWith(R"X(<Parameter name="Type" type="string" value="Fixed"/>)X",
+                                   R"X(<Parameter name="Type" type="string" value="fixed"/>)X")),
+                   {"Supports/base/Type"});
+}
+
+TEST_F(SceneTest, UnknownFace) {
+  expectInputError(write(sceneWith(R"X(<Parameter name="Face" type="string" value="ymin"/>)X",
+                                   R"X(<Parameter name="Face" type="string" value="bottom"/>)X")),
+                   {"Supports/base/Face", "bottom"});
+  expectInputError(write(sceneWith(R"X(<Parameter name="Face" type="string" value="xmax"/>)X",
+                                   R"X(<Parameter name="Face" type="string" value=""/>)X")),
+                   {"Supports/pull/Face"});
+}
+
+TEST_F(SceneTest, BadComponents) {
+  const std::string from = R"X(<Parameter name="Components" type="string" value="x"/>)X";
+  for (const char* bad : {"q", "xx", "", "xq", "w"})
+    expectInputError(
+        write(sceneWith(from, std::string(R"X(<Parameter name="Components" type="string" value=")X") + bad + "\"/>")),
+        {"Supports/pull/Components"});
+}
+
+TEST_F(SceneTest, FoundationStiffnessPositive) {
+  const std::string from = R"X(<Parameter name="Stiffness" type="double" value="1"/>)X";
+  for (const char* bad : {"0", "-2"})
+    expectInputError(
+        write(sceneWith(from, std::string(R"X(<Parameter name="Stiffness" type="double" value=")X") + bad + "\"/>")),
+        {"Supports/wall/Stiffness"});
+}
+
+TEST_F(SceneTest, BadSolverNames) {
+  const std::string from = R"X(<Parameter name="Linear Solver" type="string" value="GMRES"/>)X";
+  expectInputError(write(sceneWith(from, R"X(<Parameter name="Linear Solver" type="string" value="MINRES"/>)X")),
+                   {"Solver/Linear Solver", "MINRES"});
+  expectInputError(write(sceneWith(from, R"X(<Parameter name="Preconditioner" type="string" value="AMG"/>)X")),
+                   {"Solver/Preconditioner", "AMG"});
+  expectInputError(write(sceneWith(from, R"X(<Parameter name="Line Search" type="string" value="Wolfe"/>)X")),
+                   {"Solver/Line Search", "Wolfe"});
+  expectInputError(write(sceneWith(from, R"X(<Parameter name="Predictor" type="string" value="Secant"/>)X")),
+                   {"Solver/Predictor", "Secant"});
+}
+
+// ---------------------------------------------------------------------------
+// --set and --output
+
+TEST_F(SceneTest, SetOverrides) {
+  const std::string file = write(SceneText().str());
+  const Scene s = loadScene(file, {"Mesh/Cells={8,2,2}", "Material/c=2"}, "");
+  EXPECT_EQ(s.mesh.cells, (std::array<int, 3>{8, 2, 2}));
+  EXPECT_EQ(s.c, 2.0);
+  EXPECT_EQ(s.resolved.sublist("Material").get<double>("c"), 2.0);
+  // Other values untouched.
+  EXPECT_EQ(s.pressurePenalty, 1e-3);
+  EXPECT_EQ(s.mesh.max, (std::array<double, 3>{2, 1, 1}));
+}
+
+TEST_F(SceneTest, SetReachesNamedObjectsAndAbsentSublists) {
+  const std::string file = write(SceneText().str());
+  const Scene s = loadScene(file,
+                            {"Supports/pull/Velocity={-0.5, 0, 0.25}", "Time/Steps=7", "Solver/Line Search=Full Step",
+                             "Solver/Max Newton Iterations=3", "Title=changed", "Material/Pressure Penalty=1e-13"},
+                            "");
+  ASSERT_EQ(s.supports.size(), 3u);
+  EXPECT_EQ(s.supports[1].velocity, (std::array<double, 3>{-0.5, 0, 0.25}));
+  EXPECT_EQ(s.steps, 7);
+  EXPECT_EQ(s.solver.get<std::string>("Line Search"), "Full Step");
+  EXPECT_EQ(s.solver.get<int>("Max Newton Iterations"), 3);
+  EXPECT_EQ(s.title, "changed");
+  EXPECT_EQ(s.pressurePenalty, 1e-13);
+  // A parameter the scene file does not give (its sublist absent too): typed from the valid list.
+  const std::string bare = write(R"X(<ParameterList name="Scene">
+  <ParameterList name="Mesh"><Parameter name="Cells" type="Array(int)" value="{1, 1, 1}"/></ParameterList>
+</ParameterList>
+)X");
+  const Scene b = loadScene(bare, {"Solver/Linear Solver=Direct", "Time/Step Size=0.5"}, "");
+  EXPECT_EQ(b.solver.get<std::string>("Linear Solver"), "Direct");
+  EXPECT_EQ(b.stepSize, 0.5);
+}
+
+TEST_F(SceneTest, SetValuesAreValidated) {
+  // A value that parses but is out of range fails like the same value in the file.
+  const std::string file = write(SceneText().str());
+  expectInputError(file, {"Mesh/Cells"}, {"Mesh/Cells={8,0,2}"});
+  expectInputError(file, {"Mesh/Cells"}, {"Mesh/Cells={8,2}"});
+  expectInputError(file, {"Material/c"}, {"Material/c=0"});
+  expectInputError(file, {"Time/Steps"}, {"Time/Steps=0"});
+  expectInputError(file, {"Supports/pull/Components"}, {"Supports/pull/Components=xx"});
+  expectInputError(file, {"Solver/Linear Solver"}, {"Solver/Linear Solver=LU"});
+}
+
+TEST_F(SceneTest, SetUnknownPath) {
+  const std::string file = write(SceneText().str());
+  expectInputError(file, {"Mesh/Cels"}, {"Mesh/Cels={8,2,2}"});
+  expectInputError(file, {"Materail/c"}, {"Materail/c=2"});
+  expectInputError(file, {"Solver/Foo"}, {"Solver/Foo=1"});
+  expectInputError(file, {"Supports/pull/Stifness"}, {"Supports/pull/Stifness=2"});
+}
+
+TEST_F(SceneTest, SetUnparsableValue) {
+  const std::string file = write(SceneText().str());
+  expectInputError(file, {"Material/c", "abc"}, {"Material/c=abc"});
+  expectInputError(file, {"Material/c"}, {"Material/c=1.5x"});
+  expectInputError(file, {"Material/c"}, {"Material/c="});
+  expectInputError(file, {"Time/Steps"}, {"Time/Steps=2.5"});
+  expectInputError(file, {"Time/Steps"}, {"Time/Steps=five"});
+}
+
+TEST_F(SceneTest, SetWithoutEquals) {
+  const std::string file = write(SceneText().str());
+  expectInputError(file, {"Material/c"}, {"Material/c"});
+}
+
+TEST_F(SceneTest, OutputOverridesDirectory) {
+  const std::string file = write(SceneText().str());
+  EXPECT_EQ(loadScene(file, {}, "").outputDirectory, "out/test");
+  const Scene s = loadScene(file, {}, "/tmp/somewhere/else");
+  EXPECT_EQ(s.outputDirectory, "/tmp/somewhere/else");
+  EXPECT_EQ(s.resolved.sublist("Output").get<std::string>("Directory"), "/tmp/somewhere/else");
+  // --output wins over --set Output/Directory.
+  EXPECT_EQ(loadScene(file, {"Output/Directory=from-set"}, "from-output").outputDirectory, "from-output");
+  EXPECT_EQ(loadScene(file, {"Output/Directory=from-set"}, "").outputDirectory, "from-set");
+}
+
+TEST_F(SceneTest, ShippedInputsValidate) {
+  // The scenes in inputs/ that the integration tests run all load
+  // (CAPSTAN_INPUTS_DIR is set by CMake).
+#ifdef CAPSTAN_INPUTS_DIR
+  for (const char* name : {"uniaxial.xml", "shear.xml", "default.xml"}) {
+    const std::string file = std::string(CAPSTAN_INPUTS_DIR) + "/" + name;
+    EXPECT_NO_THROW(loadScene(file, {}, "")) << file;
+  }
+#else
+  GTEST_SKIP() << "CAPSTAN_INPUTS_DIR not defined";
+#endif
+}
+
+}  // namespace
