@@ -81,7 +81,7 @@ ParameterList validParameters() {
   sol.set("Linear Solver", std::string("Auto"),
           "Auto | GMRES | CG | Direct (Belos GMRES, Belos CG, Amesos2 KLU2). Auto: Direct up to "
           "Direct Solver Max Dofs on one rank, GMRES otherwise");
-  sol.set("Direct Solver Max Dofs", 30000, "Auto: largest problem solved directly");
+  sol.set("Direct Solver Max Dofs", 5000, "Auto: largest problem solved directly");
   sol.set("Preconditioner", std::string("ILU"), "ILU | Jacobi | None (Ifpack2: additive Schwarz RILUK, relaxation)");
   sol.set("ILU Level", 1, "ILU: level of fill (>= 0)");
   sol.set("Linear Tolerance", 1e-10, "Relative residual of each linear solve (0 < tol < 1)");
@@ -97,7 +97,7 @@ ParameterList validParameters() {
   sol.set("Max Pressure Iterations", 100, "Most pressure-anchor updates per step");
   sol.set("Pressure Acceleration Depth", 5,
           "Anderson acceleration depth of the pressure loop (0 = plain pbar <- p(x))");
-  sol.set("Minimum Solve Penalty", 1e-5,
+  sol.set("Minimum Solve Penalty", 1e-2,
           "Smallest eps1 x c used in the Newton solves: below it the condensed pressure "
           "cannot be evaluated in double precision; the pressure loop still makes v_e = V_e exact");
   sol.sublist("NOX", false, "Passed to NOX unchanged, over capstan's defaults");

@@ -58,7 +58,7 @@ std::map<GO, std::pair<double, double>> assemble(const RCP<const Comm>& comm) {
   std::map<GO, std::pair<double, double>> out;
   auto fd = f.getData();
   auto kd = Kw.getData();
-  for (size_t d = 0; d < fd.size(); ++d)
+  for (LO d = 0; d < LO(fd.size()); ++d)
     out[mesh.ownedDofMap->getGlobalElement(LO(d))] = {fd[d], kd[d]};
   return out;
 }
