@@ -31,6 +31,26 @@ IntMatrix dofsOf(const NodeView& nodes) {
   return dofs;
 }
 
+// Node ids and reference coordinates of entities (bricks: 8 nodes, faces: 4)
+// from a flat node list, into device views.
+template <class NodeView, class CoordView>
+void loadEntities(const Mesh& mesh, const std::vector<int>& nodeList, const std::string& label,
+                  NodeView& nodes, CoordView& X) {
+  const size_t nn = NodeView::static_extent(1), count = nodeList.size() / nn;
+  nodes = NodeView(label + " nodes", count);
+  X = CoordView(label + " X", count);
+  auto hn = Kokkos::create_mirror_view(nodes);
+  auto hX = Kokkos::create_mirror_view(X);
+  for (size_t e = 0; e < count; ++e)
+    for (size_t a = 0; a < nn; ++a) {
+      const int n = nodeList[nn * e + a];
+      hn(e, a) = n;
+      for (int i = 0; i < 3; ++i) hX(e, a, i) = mesh.X[3 * n + i];
+    }
+  Kokkos::deep_copy(nodes, hn);
+  Kokkos::deep_copy(X, hX);
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------- bricks
@@ -38,18 +58,7 @@ IntMatrix dofsOf(const NodeView& nodes) {
 BrickEffect::BrickEffect(const Mesh& mesh, double c, double penalty)
     : Effect("brick"), c_(c), penalty_(penalty) {
   const size_t ne = mesh.numElements();
-  nodes_ = decltype(nodes_)("brick nodes", ne);
-  X_ = decltype(X_)("brick X", ne);
-  auto hn = Kokkos::create_mirror_view(nodes_);
-  auto hX = Kokkos::create_mirror_view(X_);
-  for (size_t e = 0; e < ne; ++e)
-    for (int a = 0; a < 8; ++a) {
-      const int n = mesh.connectivity[8 * e + a];
-      hn(e, a) = n;
-      for (int i = 0; i < 3; ++i) hX(e, a, i) = mesh.X[3 * n + i];
-    }
-  Kokkos::deep_copy(nodes_, hn);
-  Kokkos::deep_copy(X_, hX);
+  loadEntities(mesh, mesh.connectivity, "brick", nodes_, X_);
   pressureAnchor = Kokkos::View<double*>("pbar", ne);
   pressure = Kokkos::View<double*>("p", ne);
   volume = Kokkos::View<double*>("v", ne);
@@ -128,17 +137,7 @@ FoundationEffect::FoundationEffect(const std::string& name, const Mesh& mesh,
     : Effect(name), k_(k) {
   const auto& quads = mesh.faces.at(face);
   const size_t nf = quads.size() / 4;
-  nodes_ = decltype(nodes_)("foundation nodes", nf);
-  X_ = decltype(X_)("foundation X", nf);
-  auto hn = Kokkos::create_mirror_view(nodes_);
-  auto hX = Kokkos::create_mirror_view(X_);
-  for (size_t f = 0; f < nf; ++f)
-    for (int a = 0; a < 4; ++a) {
-      hn(f, a) = quads[4 * f + a];
-      for (int i = 0; i < 3; ++i) hX(f, a, i) = mesh.X[3 * quads[4 * f + a] + i];
-    }
-  Kokkos::deep_copy(nodes_, hn);
-  Kokkos::deep_copy(X_, hX);
+  loadEntities(mesh, quads, "foundation", nodes_, X_);
   for (int i = 0; i < 3; ++i) mask_[i] = components[i] ? 1 : 0;
   local_.dofs = dofsOf(nodes_);
   local_.R = Matrix("foundation R", nf, 12);

@@ -72,6 +72,13 @@ class Run {
   bool solveAt(double t0, double t1, StepRecord& rec, std::string& failure);
   void recordStep(StepRecord& rec);
   StateFigures figures();
+  // Element stress (6 per element), von Mises and pressure on the host, at the
+  // last evaluated state.
+  struct ElementFields {
+    Matrix::HostMirror stress;
+    Kokkos::View<double*>::HostMirror mises, pressure;
+  };
+  ElementFields elementFields() const;
   void writeFields(int step, double time);
   void writeSummary(bool converged, const std::string& failure);
   void writeHistory();
@@ -197,15 +204,20 @@ bool Run::solveAt(double t0, double t, StepRecord& rec, std::string& failure) {
   return false;
 }
 
-StateFigures Run::figures() {
-  StateFigures s;
+Run::ElementFields Run::elementFields() const {
   auto& bricks = assembly_->bricks();
   Matrix stress;
   Kokkos::View<double*> mises;
   bricks.centroidStress(assembly_->positions(), stress, mises);
-  auto hs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), stress);
-  auto hm = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mises);
-  auto hp = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bricks.pressure);
+  return {Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), stress),
+          Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mises),
+          Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bricks.pressure)};
+}
+
+StateFigures Run::figures() {
+  StateFigures s;
+  auto& bricks = assembly_->bricks();
+  const auto [hs, hm, hp] = elementFields();
   auto hv = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bricks.volume);
   auto hV = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bricks.referenceVolume);
   // Local extrema as (min, -max) pairs so one REDUCE_MIN does all of them.
@@ -272,13 +284,7 @@ void Run::writeFields(int step, double time) {
       disp.values[3 * n + i] = ud[3 * n + i];
       coords[3 * n + i] = mesh_.X[3 * n + i] + ud[3 * n + i];
     }
-  auto& bricks = assembly_->bricks();
-  Matrix stress;
-  Kokkos::View<double*> mises;
-  bricks.centroidStress(assembly_->positions(), stress, mises);
-  auto hs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), stress);
-  auto hm = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mises);
-  auto hp = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bricks.pressure);
+  const auto [hs, hm, hp] = elementFields();
   Field p{"pressure", 1, std::vector<double>(ne)}, vm{"von_mises", 1, std::vector<double>(ne)};
   Field sig{"stress", 6, std::vector<double>(6 * ne)};
   for (size_t e = 0; e < ne; ++e) {
