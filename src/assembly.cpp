@@ -119,7 +119,7 @@ bool Assembly::evaluate(const Vector& u, Vector* f, FEMatrix* W) {
   if (W) {
     W->beginAssembly();
     W->setAllToScalar(0.0);
-    std::vector<double> vals;
+    auto& vals = rowValues_;  // kept between assemblies: no allocation per iteration
     for (size_t i = 0; i < effects_.size(); ++i) {
       const auto& L = effects_[i]->local();
       auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.dofs);

@@ -84,6 +84,7 @@ class Assembly {
   RCP<Vector> uOverlap_;
   RCP<Tpetra::FEMultiVector<>> residual_;
   std::vector<double> rawOwnedResidual_;
+  std::vector<double> rowValues_;
   NodalVectors x_, u_;
   double assemblySeconds_ = 0;
 };
