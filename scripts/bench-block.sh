@@ -15,7 +15,7 @@ import json, sys
 d = json.load(open(sys.argv[1]))
 s = d["steps"][0]; t = d["timing"]
 print(f"ranks={d['ranks']} dofs={d['mesh']['dofs']} newton={s['newton_iterations']} "
-      f"linear={s['linear_iterations']} pressure_loops={s['pressure_iterations']} "
+      f"linear={s['linear_iterations']} augmentations={s['augmentations']} "
       f"step={s['wall_seconds']:.1f}s assembly={t['assembly']:.1f}s linear_solve={t['linear_solve']:.1f}s "
       f"assembly/newton={t['assembly']/max(1,s['newton_iterations']):.3f}s")
 PY

@@ -3,13 +3,24 @@
 #include <Kokkos_Timer.hpp>
 #include <Teuchos_CommHelpers.hpp>
 
+#include <algorithm>
+#include <set>
+
 namespace capstan {
+
+namespace {
+// An effect's active flags on the host (empty: every entity is active).
+Kokkos::View<int*>::HostMirror activeOnHost(const LocalSystem& L) {
+  return Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.active);
+}
+}  // namespace
 
 Assembly::Assembly(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
   // Effects the scene calls for, and nothing else.
   const double epsSolve =
       std::max(scene.pressurePenalty, scene.solver.get<double>("Minimum Solve Penalty") / scene.c);
-  auto bricks = std::make_unique<BrickEffect>(mesh, scene.c, epsSolve);
+  auto bricks = std::make_unique<BrickEffect>(mesh, scene.c, epsSolve,
+                                              scene.solver.get<double>("Volume Tolerance"));
   bricks_ = bricks.get();
   effects_.push_back(std::move(bricks));
   const size_t ndof = 3 * mesh.numOverlapNodes();
@@ -33,6 +44,40 @@ Assembly::Assembly(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
         constraints_.supportOf[3 * n + i] = id;
         constraints_.velocity[3 * n + i] = s.type == "Displacement" ? s.velocity[i] : 0.0;
       }
+  }
+
+  for (const auto& c : scene.capstans) {
+    ContactEffect::Settings set;
+    set.radius = c.radius;
+    set.axisPoint = c.axisPoint;
+    set.axisDirection = c.axisDirection;
+    set.velocity = c.velocity;
+    set.solvePenalty = std::max(c.penalty, c.minimumSolvePenalty);
+    set.compliance = c.method == "Augmented Lagrangian" ? 0.0 : c.penalty;
+    set.tolerance = c.penetrationTolerance;
+    set.maxAugmentations = c.maxAugmentations;
+    set.rule = c.quadrature;
+    // Candidate faces, each once even if two named faces share one. Every
+    // capstan's faces also get an index in the union of all candidate faces
+    // (the contact-face grid of fields.h5).
+    std::vector<int> quads;
+    std::set<std::array<int, 4>> mine;
+    contactFaceOf_.emplace_back();
+    for (const auto& name : c.contactFaces) {
+      const auto& q = mesh.faces.at(name);
+      for (size_t f = 0; f < q.size(); f += 4) {
+        std::array<int, 4> key{q[f], q[f + 1], q[f + 2], q[f + 3]};
+        std::sort(key.begin(), key.end());
+        if (!mine.insert(key).second) continue;
+        auto [it, fresh] = contactFaceIndex_.insert({key, int(contactFaceIndex_.size())});
+        if (fresh) contactFaceNodes_.insert(contactFaceNodes_.end(), q.begin() + f, q.begin() + f + 4);
+        quads.insert(quads.end(), q.begin() + f, q.begin() + f + 4);
+        contactFaceOf_.back().push_back(it->second);
+      }
+    }
+    auto effect = std::make_unique<ContactEffect>("contact:" + c.name, mesh, quads, set);
+    contacts_.push_back(effect.get());
+    effects_.push_back(std::move(effect));
   }
 
   // Graph from every effect's entities: built once, fixed sparsity.
@@ -124,9 +169,11 @@ bool Assembly::evaluate(const Vector& u, Vector* f, FEMatrix* W) {
       const auto& L = effects_[i]->local();
       auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.dofs);
       auto K = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.K);
+      auto active = activeOnHost(L);
       const size_t n = dofs.extent(1);
       vals.resize(n);
       for (size_t e = 0; e < dofs.extent(0); ++e) {
+        if (active.size() && !active(e)) continue;
         const LO* cols = &columns_[i][e * n];
         for (size_t k = 0; k < n; ++k) {
           if (supportOf[dofs(e, k)] >= 0) continue;
@@ -157,8 +204,10 @@ void Assembly::sumEntityVectors(const std::vector<Matrix>& values) {
     for (size_t i = 0; i < effects_.size(); ++i) {
       auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), effects_[i]->local().dofs);
       auto v = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), values[i]);
+      auto active = activeOnHost(effects_[i]->local());
       for (size_t e = 0; e < dofs.extent(0); ++e)
-        for (size_t k = 0; k < dofs.extent(1); ++k) r[dofs(e, k)] += v(e, k);
+        if (!active.size() || active(e))
+          for (size_t k = 0; k < dofs.extent(1); ++k) r[dofs(e, k)] += v(e, k);
     }
   }
   residual_->endAssembly();  // one export: shared rows added into their owners
@@ -174,9 +223,14 @@ void Assembly::tangentAction(const Vector& z, Vector& y) {
     auto K = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.K);
     Matrix out("K z", dofs.extent(0), dofs.extent(1));
     auto ho = Kokkos::create_mirror_view(out);
+    auto active = activeOnHost(L);
     for (size_t e = 0; e < dofs.extent(0); ++e)
       for (size_t k = 0; k < dofs.extent(1); ++k) {
         double s = 0;
+        if (active.size() && !active(e)) {
+          ho(e, k) = 0;
+          continue;
+        }
         for (size_t l = 0; l < dofs.extent(1); ++l) s += K(e, k, l) * zd[dofs(e, l)];
         ho(e, k) = s;
       }

@@ -12,6 +12,7 @@
 #include <Tpetra_Vector.hpp>
 
 #include <array>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -45,6 +46,16 @@ class Assembly {
   BrickEffect& bricks() { return *bricks_; }
   const std::vector<std::unique_ptr<Effect>>& effects() const { return effects_; }
   const std::vector<FoundationEffect*>& foundations() const { return foundations_; }
+  const std::vector<ContactEffect*>& contacts() const { return contacts_; }
+  // The union of all capstans' candidate faces on this rank (4 overlapped node
+  // ids each), and for capstan i the union index of each of its faces.
+  const std::vector<int>& contactFaceNodes() const { return contactFaceNodes_; }
+  const std::vector<int>& contactFacesOf(size_t capstan) const { return contactFaceOf_[capstan]; }
+
+  // The increment being solved (effects that move with time evaluate at tEnd).
+  void setInterval(double tStart, double tEnd) {
+    for (auto& e : effects_) e->setInterval(tStart, tEnd);
+  }
 
   // Sets the constrained entries of u to their values at time t.
   void applyConstraints(Vector& u, double t) const;
@@ -77,6 +88,10 @@ class Assembly {
   std::vector<std::unique_ptr<Effect>> effects_;
   BrickEffect* bricks_ = nullptr;
   std::vector<FoundationEffect*> foundations_;
+  std::vector<ContactEffect*> contacts_;
+  std::map<std::array<int, 4>, int> contactFaceIndex_;
+  std::vector<int> contactFaceNodes_;
+  std::vector<std::vector<int>> contactFaceOf_;
   Constraints constraints_;
   RCP<FEGraph> graph_;
   std::vector<std::vector<LO>> columns_;  // per effect: [entity * dofs + k] matrix column ids

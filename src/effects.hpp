@@ -25,6 +25,10 @@ struct LocalSystem {
   IntMatrix dofs;  // [entity][k]: overlapped dof ids (3 * node + component)
   Matrix R;        // [entity][k]
   Tensor3 K;       // [entity][k][l]
+  // Optional: entities with active(e) == 0 contribute nothing this evaluation
+  // (contact faces away from the capstan); empty = all active. The matrix
+  // graph still holds them, so the sparsity pattern never changes.
+  Kokkos::View<int*> active;
 };
 
 class Effect {
@@ -37,6 +41,28 @@ class Effect {
   const LocalSystem& local() const { return local_; }
   long launches() const { return launches_; }
   double seconds() const { return seconds_; }
+
+  // The load increment being solved, from tStart (the last converged state) to
+  // tEnd: effects that move with time (capstans) evaluate at tEnd.
+  virtual void setInterval(double /*tStart*/, double /*tEnd*/) {}
+
+  // Augmentation, the outer loop around each Newton solve (element pressure
+  // anchors, contact multipliers): the multipliers are held fixed in a Newton
+  // solve; after it converges they move to their fixed-point map G, until each
+  // effect's constraint violation is within its tolerance. Effects without
+  // multipliers return an empty view.
+  virtual Kokkos::View<double*> multipliers() { return {}; }
+  // G(multipliers) at the last evaluation, into `next` (same size).
+  virtual void multiplierMap(const Kokkos::View<double*>& /*next*/) const {}
+  // Whether Anderson mixing may accelerate this effect's multiplier loop.
+  virtual bool accelerated() const { return true; }
+  // Brings mixed multipliers back into their admissible set (e.g. lambda >= 0).
+  virtual void projectMultipliers() {}
+  // Largest violation of the constraint on this rank at the last evaluation,
+  // and the tolerance it must meet (same units).
+  virtual double constraintViolation() const { return 0; }
+  virtual double constraintTolerance() const { return 0; }
+  virtual std::string constraintName() const { return name(); }
 
  protected:
   virtual void launch(const NodalVectors& x, const NodalVectors& u, bool tangent) = 0;
@@ -51,7 +77,7 @@ class Effect {
 // Q1P0 incompressible neo-Hookean bricks, the whole body.
 class BrickEffect : public Effect {
  public:
-  BrickEffect(const Mesh& mesh, double c, double penalty);
+  BrickEffect(const Mesh& mesh, double c, double penalty, double volumeTolerance);
   Kokkos::View<double*> pressureAnchor;  // pbar per element (outer loop updates it)
   Kokkos::View<double*> pressure;        // p(x) at the last evaluation
   Kokkos::View<double*> volume;          // v at the last evaluation
@@ -61,13 +87,20 @@ class BrickEffect : public Effect {
   void centroidStress(const NodalVectors& x, Matrix& stress, Kokkos::View<double*>& mises) const;
   double c() const { return c_; }
 
+  // Pressure anchors: G(pbar) = p(x); violation max |v/V - 1|.
+  Kokkos::View<double*> multipliers() override { return pressureAnchor; }
+  void multiplierMap(const Kokkos::View<double*>& next) const override;
+  double constraintViolation() const override;
+  double constraintTolerance() const override { return volumeTolerance_; }
+  std::string constraintName() const override { return "volume change"; }
+
  protected:
   void launch(const NodalVectors& x, const NodalVectors& u, bool tangent) override;
 
  private:
   Kokkos::View<int* [8], Kokkos::LayoutRight> nodes_;
   Kokkos::View<double* [8][3], Kokkos::LayoutRight> X_;
-  double c_, penalty_;
+  double c_, penalty_, volumeTolerance_;
 };
 
 // Elastic foundation on one face: t = -k (x - X) on the listed components.
@@ -86,6 +119,77 @@ class FoundationEffect : public Effect {
   Kokkos::View<double* [4][3], Kokkos::LayoutRight> X_;
   double k_;
   int mask_[3];
+};
+
+// Normal contact of candidate faces with one rigid capstan (kernels/contact.hpp).
+// Penalty or augmented Lagrangian; faces the capstan does not touch are
+// inactive and cost only their gap check.
+class ContactEffect : public Effect {
+ public:
+  struct Settings {
+    double radius = 1;
+    std::array<double, 3> axisPoint{}, axisDirection{0, 0, 1}, velocity{};
+    double solvePenalty = 1e-3;  // eps of the Newton solves
+    double compliance = 1e-3;    // kappa: g = kappa t_n at the fixed point (0: exact contact)
+    double tolerance = 0;        // on eps |t_n - lambda| (length); 0 = 1e-4 x smallest edge
+    int maxAugmentations = 50;
+    int rule = 0;                // kernels::FaceRule
+  };
+  ContactEffect(const std::string& name, const Mesh& mesh, const std::vector<int>& quads,
+                const Settings& settings);
+
+  void setInterval(double tStart, double tEnd) override;
+  // Multipliers only where they change the answer: the augmented Lagrangian,
+  // or a penalty solved at a larger penalty than the scene's.
+  bool augmented() const { return settings_.compliance < settings_.solvePenalty; }
+  Kokkos::View<double*> multipliers() override {
+    return augmented() ? lambda_ : Kokkos::View<double*>();
+  }
+  void multiplierMap(const Kokkos::View<double*>& next) const override;
+  void projectMultipliers() override;
+  // Plain Uzawa: each update removes most of the penetration already (the
+  // penalty is much stiffer than the body), and mixing across the kink of
+  // max(0, .) where points enter or leave contact made the loop wander.
+  bool accelerated() const override { return false; }
+  double constraintViolation() const override;
+  double constraintTolerance() const override { return settings_.tolerance; }
+  std::string constraintName() const override { return name() + " penetration"; }
+  int maxAugmentations() const { return settings_.maxAugmentations; }
+
+  // This rank's share of the capstan's figures at the last evaluation. The
+  // contact angles are measured about the axis from `reference` (a unit vector
+  // normal to the axis; zero: angles not wanted).
+  struct Figures {
+    std::array<double, 3> force{};  // body on capstan
+    double torque = 0;              // body on capstan, about its axis
+    double maxPenetration = 0, peakPressure = 0, area = 0;
+    long points = 0;
+    double angleMin = 0, angleMax = 0;  // +-inf-like sentinels when no point
+  };
+  Figures figures(const std::array<double, 3>& reference) const;
+  // Per face: mean contact pressure, largest gap, mean traction on the body (3).
+  void faceFields(std::vector<double>& pressure, std::vector<double>& gap,
+                  std::vector<double>& traction) const;
+  const std::array<double, 3>& axisDirection() const { return beta_; }
+  double radius() const { return settings_.radius; }
+  // Geometric stiffness of the contact tangent on (default) or off (for a
+  // step predictor only, see kernels/contact.hpp).
+  void setGeometricStiffness(bool on) { geometric_ = on; }
+  size_t numFaces() const { return nodes_.extent(0); }
+
+ protected:
+  void launch(const NodalVectors& x, const NodalVectors& u, bool tangent) override;
+
+ private:
+  Kokkos::View<int* [4], Kokkos::LayoutRight> nodes_;
+  Kokkos::View<double* [4][3], Kokkos::LayoutRight> X_;
+  Kokkos::View<double*> lambda_;  // [face * kMaxFacePoints + q]
+  // Per face and point at the last evaluation: gap, pressure, weight, area, e (3), x (3).
+  Kokkos::View<double** [10], Kokkos::LayoutRight> points_;
+  Settings settings_;
+  std::array<double, 3> beta_{};  // unit axis direction
+  double time_ = 0;
+  bool geometric_ = true;
 };
 
 }  // namespace capstan

@@ -68,6 +68,13 @@ ParameterList validParameters() {
               "Augmented Lagrangian: stop when max penetration is below this; 0 = 1e-4 x the "
               "smallest contact-face edge");
   contact.set("Max Augmentations", 50, "Augmented Lagrangian: most multiplier updates per step");
+  contact.set("Minimum Solve Penalty", 0.0,
+              "Newton solves use eps = max(Penalty, this); multiplier updates then reach the "
+              "answer of Penalty (a well-conditioned solve for a tiny penalty); 0 = off");
+  contact.set("Quadrature", std::string("Auto"),
+              "Contact points per face: Auto | Gauss 2x2 | Gauss 3x3 | Nodal (at the face's nodes). "
+              "Auto: Gauss 2x2 for Penalty, Nodal for Augmented Lagrangian (exact contact at every "
+              "Gauss point of flat faces on a curved capstan over-constrains the body)");
   auto& fr = c.sublist("Friction", false, "Friction between body and capstan (formulation.md §3)");
   fr.set("Law", std::string("None"), "None | Tanh | Arctan | Coulomb");
   fr.set("Coefficient", 0.0, "mu >= 0");
@@ -364,6 +371,19 @@ Scene loadScene(const std::string& file, const std::vector<std::string>& sets,
     cs.penalty = positive(ct, "Penalty", v, path + "/Contact");
     cs.penetrationTolerance = ct.get<double>("Penetration Tolerance");
     if (!(cs.penetrationTolerance >= 0)) v.fail(path + "/Contact/Penetration Tolerance", "must be >= 0");
+    cs.minimumSolvePenalty = ct.get<double>("Minimum Solve Penalty");
+    if (!(cs.minimumSolvePenalty >= 0) || !std::isfinite(cs.minimumSolvePenalty))
+      v.fail(path + "/Contact/Minimum Solve Penalty", "must be >= 0");
+    const std::string rule = ct.get<std::string>("Quadrature");
+    if (rule == "Auto") cs.quadrature = cs.method == "Augmented Lagrangian" ? 2 : 0;
+    else if (rule == "Gauss 2x2") cs.quadrature = 0;
+    else if (rule == "Gauss 3x3") cs.quadrature = 1;
+    else if (rule == "Nodal") cs.quadrature = 2;
+    else v.fail(path + "/Contact/Quadrature", "'" + rule + "' is not a rule (Auto, Gauss 2x2, Gauss 3x3, Nodal)");
+    if (cs.method == "Augmented Lagrangian" && cs.quadrature != 2)
+      v.fail(path + "/Contact/Quadrature",
+             "the Augmented Lagrangian needs Nodal (or Auto): zero gap at every Gauss point of flat "
+             "faces against a curved capstan is impossible, and the multipliers would never settle");
     cs.maxAugmentations = ct.get<int>("Max Augmentations");
     if (cs.maxAugmentations < 1) v.fail(path + "/Contact/Max Augmentations", "must be >= 1");
     const auto& fr = c.sublist("Friction");

@@ -30,8 +30,9 @@ struct CapstanSpec {
   double angularVelocity = 0;
   std::vector<std::string> contactFaces;
   std::string method;  // Penalty | Augmented Lagrangian
-  double penalty = 0, penetrationTolerance = 0;
+  double penalty = 0, penetrationTolerance = 0, minimumSolvePenalty = 0;
   int maxAugmentations = 0;
+  int quadrature = 0;  // kernels::FaceRule: 0 Gauss 2x2, 1 Gauss 3x3, 2 Nodal
   std::string frictionLaw;  // None | Tanh | Arctan | Coulomb
   double frictionCoefficient = 0, regularization = 0;
 };

@@ -34,12 +34,26 @@ MPI_Comm rawComm(const RCP<const Comm>& comm) {
   return mpi.is_null() ? MPI_COMM_SELF : (*mpi->getRawMpiComm())();
 }
 
+// One capstan's figures at a converged step (global).
+struct CapstanRecord {
+  std::string name;
+  std::array<double, 3> force{};  // body on capstan
+  double torque = 0, maxPenetration = 0, peakPressure = 0, area = 0, width = 0;
+  long points = 0;
+};
+
 struct StepRecord {
   int step = 0;
   double time = 0;
-  int newton = 0, linear = 0, cutbacks = 0, pressureIterations = 0;
+  int newton = 0, linear = 0, cutbacks = 0, augmentations = 0;
   double residual = 0, wall = 0, volumeChange = 0;
   std::vector<std::pair<std::string, std::array<double, 3>>> supports;
+  std::vector<CapstanRecord> capstans;
+  double maxPenetration() const {
+    double m = 0;
+    for (const auto& c : capstans) m = std::max(m, c.maxPenetration);
+    return m;
+  }
 };
 
 // Figures of the current state, reduced over all ranks.
@@ -71,6 +85,19 @@ class Run {
   void predict(double t0, double t1, double bareResidual, StepRecord& rec);
   bool solveAt(double t0, double t1, StepRecord& rec, std::string& failure);
   void recordStep(StepRecord& rec);
+  CapstanRecord capstanFigures(const ContactEffect& contact) const;
+  // Every effect's augmentation multipliers (pressure anchors, contact
+  // multipliers) as one vector of this rank's values.
+  // multiplier values of this rank, of the effects that are (or are not)
+  // Anderson-accelerated.
+  std::vector<double> multipliers(bool accelerated) const;
+  std::vector<double> multiplierMap(bool accelerated) const;
+  void setMultipliers(const std::vector<double>& values, bool accelerated);
+  struct Multipliers {
+    std::vector<double> accelerated, plain;
+  };
+  Multipliers saveMultipliers() const;
+  void restoreMultipliers(const Multipliers& m);
   StateFigures figures();
   // Element stress (6 per element), von Mises and pressure on the host, at the
   // last evaluated state.
@@ -97,6 +124,7 @@ class Run {
   std::vector<StepRecord> steps_;
   fs::path dir_;
   double outputSeconds_ = 0;
+  long numContactFaces_ = 0;  // global, each candidate face once
   double absTolerance_ = 0;
   double forceScale_ = 1;  // c L^2, L the body's largest extent
 };
@@ -110,7 +138,12 @@ void Run::predict(double t0, double t1, double bareResidual, StepRecord& rec) {
   Vector z(map), Kz(map), f(map), rhs(map), du(map);
   assembly_->constraintIncrement(z, t0, t1);
   auto W = assembly_->createMatrix();
-  if (!assembly_->evaluate(*u_, &f, W.get())) return;
+  // The bare state penetrates the capstans by the whole increment: leave out
+  // the contact's geometric stiffness (t_n / d, large there) from this tangent.
+  for (auto* c : assembly_->contacts()) c->setGeometricStiffness(false);
+  const bool valid = assembly_->evaluate(*u_, &f, W.get());
+  for (auto* c : assembly_->contacts()) c->setGeometricStiffness(true);
+  if (!valid) return;
   assembly_->tangentAction(z, Kz);
   {
     auto r = rhs.getDataNonConst();
@@ -122,15 +155,26 @@ void Run::predict(double t0, double t1, double bareResidual, StepRecord& rec) {
   const int its = newton_->linearSolve(W, rhs, du);
   if (its < 0) return;  // keep the plain guess
   rec.linear += its;
-  Vector trial(*u_, Teuchos::Copy);
-  trial.update(1.0, du, 1.0, z, 1.0);
-  assembly_->applyConstraints(trial, t1);
-  if (!assembly_->evaluate(trial, &f, nullptr)) return;  // predictor inverts an element
-  if (f.norm2() < bareResidual) u_->update(1.0, trial, 0.0);
+  // The linear response can overshoot where contact or large strain makes the
+  // problem strongly nonlinear (an element inverts, or the residual grows):
+  // then try shorter steps along du before keeping the plain guess.
+  for (double alpha = 1; alpha > 0.1; alpha /= 2) {
+    Vector trial(*u_, Teuchos::Copy);
+    trial.update(alpha, du, 1.0, z, 1.0);
+    assembly_->applyConstraints(trial, t1);
+    const bool valid = assembly_->evaluate(trial, &f, nullptr);
+    if (std::getenv("CAPSTAN_NEWTON_LOG") && rank0_) std::printf("    predictor alpha %g valid %d |R| %.3e bare %.3e\n", alpha, int(valid), f.norm2(), bareResidual);
+    if (!valid) continue;  // inverts an element
+    if (f.norm2() < bareResidual) {
+      u_->update(1.0, trial, 0.0);
+      return;
+    }
+  }
 }
 
 bool Run::solveAt(double t0, double t, StepRecord& rec, std::string& failure) {
   const auto& sol = scene_.solver;
+  assembly_->setInterval(t0, t);
   // Residual of the bare load increment: the predictor must beat it, and the
   // Newton tolerance is relative to it.
   Vector f(u_->getMap());
@@ -148,15 +192,17 @@ bool Run::solveAt(double t0, double t, StepRecord& rec, std::string& failure) {
   // to it would accept a poorly converged state.
   const double r0 = std::min(bare, forceScale_);
   const double tol = std::max(sol.get<double>("Newton Relative Tolerance") * r0, absTolerance_);
-  auto& bricks = assembly_->bricks();
-  const double volTol = sol.get<double>("Volume Tolerance");
-  const int maxPressure = sol.get<int>("Max Pressure Iterations");
+  // The augmentation loop: Newton at fixed multipliers, then each effect's
+  // constraint is checked and the multipliers move to their fixed-point map
+  // (Anderson-accelerated, formulation.md §1 and §2).
+  int maxOuter = sol.get<int>("Max Pressure Iterations");
+  for (const auto* c : assembly_->contacts()) maxOuter = std::max(maxOuter, c->maxAugmentations());
   AndersonMixing mixing(sol.get<int>("Pressure Acceleration Depth"), comm_);
-  for (int it = 1; it <= maxPressure; ++it) {
-    // After an anchor update the residual may already be below the step's
-    // tolerance; x must still respond to the new pbar, or the loop drifts
-    // without moving v. So later solves reduce the residual by 1e-6 (down to
-    // round-off, 1e-3 x the absolute tolerance).
+  for (int it = 1; it <= maxOuter; ++it) {
+    // After a multiplier update the residual may already be below the step's
+    // tolerance; x must still respond to the new multipliers, or the loop
+    // drifts without moving v. So later solves reduce the residual by 1e-6
+    // (down to round-off, 1e-3 x the absolute tolerance).
     double tolIt = tol;
     if (it > 1) {
       assembly_->evaluate(*u_, &f, nullptr);
@@ -166,7 +212,7 @@ bool Run::solveAt(double t0, double t, StepRecord& rec, std::string& failure) {
     rec.newton += r.iterations;
     rec.linear += r.linearIterations;
     rec.residual = r.residualNorm;
-    rec.pressureIterations = it;
+    rec.augmentations = it;
     if (!opt_.quiet && rank0_ && std::getenv("CAPSTAN_NEWTON_LOG")) {
       std::printf("    newton |R|:");
       for (double n : r.residualHistory) std::printf(" %.3e", n);
@@ -176,31 +222,74 @@ bool Run::solveAt(double t0, double t, StepRecord& rec, std::string& failure) {
       failure = r.failure;
       return false;
     }
-    // Refresh p(x), v at the converged state, then the anchor pbar <- p(x).
+    // Refresh p(x), v, contact pressures at the converged state.
     assembly_->evaluate(*u_, &f, nullptr);
-    double change = 0;
-    auto v = bricks.volume, V = bricks.referenceVolume;
-    Kokkos::parallel_reduce(
-        "volume change", Kokkos::RangePolicy<ExecSpace>(0, v.extent(0)),
-        KOKKOS_LAMBDA(int e, double& m) {
-          const double d = Kokkos::Experimental::fabs(v(e) / V(e) - 1);
-          m = d > m ? d : m;
-        },
-        Kokkos::Max<double>(change));
-    double global = 0;
-    Teuchos::reduceAll(*comm_, Teuchos::REDUCE_MAX, change, Teuchos::outArg(global));
-    rec.volumeChange = global;
-    if (global <= volTol) return true;
-    // Next anchor: Anderson-accelerated pbar <- p(x).
-    auto hpbar = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bricks.pressureAnchor);
-    auto hp = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bricks.pressure);
-    const auto next = mixing.next(std::vector<double>(hpbar.data(), hpbar.data() + hpbar.size()),
-                                  std::vector<double>(hp.data(), hp.data() + hp.size()));
-    for (size_t e = 0; e < next.size(); ++e) hpbar(e) = next[e];
-    Kokkos::deep_copy(bricks.pressureAnchor, hpbar);
+    bool met = true;
+    for (const auto& e : assembly_->effects()) {
+      double v = 0;
+      Teuchos::reduceAll(*comm_, Teuchos::REDUCE_MAX, e->constraintViolation(), Teuchos::outArg(v));
+      if (e.get() == &assembly_->bricks()) rec.volumeChange = v;
+      if (!opt_.quiet && rank0_ && std::getenv("CAPSTAN_NEWTON_LOG"))
+        std::printf("    %s: %.3e (tolerance %.1e)\n", e->constraintName().c_str(), v, e->constraintTolerance());
+      if (v <= e->constraintTolerance()) continue;
+      met = false;
+      const auto* contact = dynamic_cast<const ContactEffect*>(e.get());
+      if (contact && it >= contact->maxAugmentations()) {
+        failure = e->constraintName() + " " + Teuchos::toString(v) + " above its tolerance " +
+                  Teuchos::toString(e->constraintTolerance()) + " after " + std::to_string(it) +
+                  " augmentations";
+        return false;
+      }
+    }
+    if (met) return true;
+    setMultipliers(mixing.next(multipliers(true), multiplierMap(true)), true);
+    setMultipliers(multiplierMap(false), false);
   }
-  failure = "pressure loop did not reach Volume Tolerance";
+  failure = "augmentation loop did not meet the volume and contact tolerances in " +
+            std::to_string(maxOuter) + " iterations";
   return false;
+}
+
+std::vector<double> Run::multipliers(bool accelerated) const {
+  std::vector<double> out;
+  for (const auto& e : assembly_->effects()) {
+    if (e->accelerated() != accelerated) continue;
+    auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), e->multipliers());
+    out.insert(out.end(), h.data(), h.data() + h.size());
+  }
+  return out;
+}
+
+std::vector<double> Run::multiplierMap(bool accelerated) const {
+  std::vector<double> out;
+  for (const auto& e : assembly_->effects()) {
+    if (e->accelerated() != accelerated) continue;
+    Kokkos::View<double*> next("next multipliers", e->multipliers().extent(0));
+    e->multiplierMap(next);
+    auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), next);
+    out.insert(out.end(), h.data(), h.data() + h.size());
+  }
+  return out;
+}
+
+void Run::setMultipliers(const std::vector<double>& values, bool accelerated) {
+  size_t offset = 0;
+  for (const auto& e : assembly_->effects()) {
+    if (e->accelerated() != accelerated) continue;
+    auto view = e->multipliers();
+    auto h = Kokkos::create_mirror_view(view);
+    for (size_t i = 0; i < h.size(); ++i) h(i) = values[offset + i];
+    offset += h.size();
+    Kokkos::deep_copy(view, h);
+    e->projectMultipliers();
+  }
+}
+
+Run::Multipliers Run::saveMultipliers() const { return {multipliers(true), multipliers(false)}; }
+
+void Run::restoreMultipliers(const Multipliers& m) {
+  setMultipliers(m.accelerated, true);
+  setMultipliers(m.plain, false);
 }
 
 Run::ElementFields Run::elementFields() const {
@@ -269,6 +358,42 @@ void Run::recordStep(StepRecord& rec) {
     byName[f->name().substr(std::string("foundation:").size())] = {g[0], g[1], g[2]};
   }
   for (const auto& s : scene_.supports) rec.supports.push_back({s.name, byName[s.name]});
+  for (const auto* c : assembly_->contacts()) rec.capstans.push_back(capstanFigures(*c));
+}
+
+CapstanRecord Run::capstanFigures(const ContactEffect& contact) const {
+  CapstanRecord r;
+  r.name = contact.name().substr(std::string("contact:").size());
+  // Pass 1: sums and maxima. Pass 2: contact angles about the axis, measured
+  // from the direction of the contact's resultant (so the contact arc never
+  // straddles the +-pi cut), for the contact width.
+  auto fig = contact.figures({0, 0, 0});
+  double sums[5] = {fig.force[0], fig.force[1], fig.force[2], fig.torque, fig.area}, gs[5];
+  Teuchos::reduceAll(*comm_, Teuchos::REDUCE_SUM, 5, sums, gs);
+  double maxima[2] = {fig.maxPenetration, fig.peakPressure}, gm[2];
+  Teuchos::reduceAll(*comm_, Teuchos::REDUCE_MAX, 2, maxima, gm);
+  long points = 0;
+  Teuchos::reduceAll(*comm_, Teuchos::REDUCE_SUM, fig.points, Teuchos::outArg(points));
+  r.force = {gs[0], gs[1], gs[2]};
+  r.torque = gs[3];
+  r.area = gs[4];
+  r.maxPenetration = gm[0];
+  r.peakPressure = gm[1];
+  r.points = points;
+  // The body pushes the capstan away from itself: the contact lies along -force.
+  const auto& b = contact.axisDirection();
+  std::array<double, 3> ref{-gs[0], -gs[1], -gs[2]};
+  const double along = ref[0] * b[0] + ref[1] * b[1] + ref[2] * b[2];
+  for (int i = 0; i < 3; ++i) ref[i] -= along * b[i];
+  const double n = std::sqrt(ref[0] * ref[0] + ref[1] * ref[1] + ref[2] * ref[2]);
+  if (points > 0 && n > 0) {
+    for (double& x : ref) x /= n;
+    const auto angles = contact.figures(ref);
+    double lo[2] = {angles.angleMin, -angles.angleMax}, glo[2];
+    Teuchos::reduceAll(*comm_, Teuchos::REDUCE_MIN, 2, lo, glo);
+    r.width = contact.radius() * (-glo[1] - glo[0]);
+  }
+  return r;
 }
 
 void Run::writeFields(int step, double time) {
@@ -291,23 +416,47 @@ void Run::writeFields(int step, double time) {
     vm.values[e] = hm(e);
     for (int k = 0; k < 6; ++k) sig.values[6 * e + k] = hs(e, k);
   }
-  writer_->writeStep(step, time, coords, {disp}, {p, vm, sig}, {});
+  // Contact faces: pressure and traction summed over the capstans, the largest gap.
+  const size_t nf = assembly_->contactFaceNodes().size() / 4;
+  Field cp{"contact_pressure", 1, std::vector<double>(nf, 0.0)};
+  Field gap{"gap", 1, std::vector<double>(nf, -1e300)};
+  Field ct{"contact_traction", 3, std::vector<double>(3 * nf, 0.0)};
+  const auto& contacts = assembly_->contacts();
+  for (size_t c = 0; c < contacts.size(); ++c) {
+    std::vector<double> pc, gc, tc;
+    contacts[c]->faceFields(pc, gc, tc);
+    const auto& index = assembly_->contactFacesOf(c);
+    for (size_t f = 0; f < index.size(); ++f) {
+      cp.values[index[f]] += pc[f];
+      gap.values[index[f]] = std::max(gap.values[index[f]], gc[f]);
+      for (int i = 0; i < 3; ++i) ct.values[3 * index[f] + i] += tc[3 * f + i];
+    }
+  }
+  std::vector<Field> faceFields;
+  if (numContactFaces_ > 0) faceFields = {cp, gap, ct};
+  writer_->writeStep(step, time, coords, {disp}, {p, vm, sig}, faceFields);
   outputSeconds_ += since(t);
 }
 
 void Run::writeHistory() {
   if (!rank0_) return;
   std::ostringstream out;
-  out << "step,time,newton_iterations,linear_iterations,cutbacks,pressure_iterations,residual_norm,"
+  out << "step,time,newton_iterations,linear_iterations,cutbacks,augmentations,residual_norm,"
          "max_abs_volume_change,wall_seconds";
   for (const auto& s : scene_.supports) out << "," << s.name << "_fx," << s.name << "_fy," << s.name << "_fz";
+  for (const auto& c : scene_.capstans)
+    for (const char* k : {"_fx", "_fy", "_fz", "_max_penetration", "_contact_points"}) out << "," << c.name << k;
   out << "\n";
   for (const auto& r : steps_) {
     out << r.step << "," << json::number(r.time) << "," << r.newton << "," << r.linear << ","
-        << r.cutbacks << "," << r.pressureIterations << "," << json::number(r.residual) << ","
+        << r.cutbacks << "," << r.augmentations << "," << json::number(r.residual) << ","
         << json::number(r.volumeChange) << "," << json::number(r.wall);
     for (const auto& s : r.supports)
       for (double x : s.second) out << "," << json::number(x);
+    for (const auto& c : r.capstans) {
+      for (double x : c.force) out << "," << json::number(x);
+      out << "," << json::number(c.maxPenetration) << "," << c.points;
+    }
     out << "\n";
   }
   writeAtomically(dir_ / "history.csv", out.str());
@@ -326,15 +475,26 @@ void Run::writeSummary(bool converged, const std::string& failure) {
     const auto& r = steps_[i];
     Object sup;
     for (const auto& sp : r.supports) sup.add(sp.first, Object().add("force", vec(sp.second)).str());
+    Object caps;
+    for (const auto& c : r.capstans)
+      caps.add(c.name, Object().add("force", vec(c.force))
+                           .add("max_penetration", json::number(c.maxPenetration))
+                           .add("contact_points", json::number(c.points))
+                           .add("stick_points", json::number(0))
+                           .add("slip_points", json::number(0))  // friction states: none without friction
+                           .add("torque", json::number(c.torque))
+                           .add("contact_area", json::number(c.area))
+                           .add("peak_pressure", json::number(c.peakPressure))
+                           .add("contact_width", json::number(c.width)).str());
     Object o;
     o.add("step", json::number(r.step)).add("time", json::number(r.time))
         .add("newton_iterations", json::number(r.newton))
         .add("linear_iterations", json::number(r.linear))
         .add("cutbacks", json::number(r.cutbacks))
-        .add("pressure_iterations", json::number(r.pressureIterations))
+        .add("augmentations", json::number(r.augmentations))
         .add("residual_norm", json::number(r.residual))
         .add("max_abs_volume_change", json::number(r.volumeChange))
-        .add("capstans", Object().str())
+        .add("capstans", caps.str())
         .add("supports", sup.str())
         .add("wall_seconds", json::number(r.wall));
     stepList += (i ? ",\n    " : "\n    ") + o.str();
@@ -364,7 +524,7 @@ void Run::writeSummary(bool converged, const std::string& failure) {
   mesh.add("nodes", json::number(long(mesh_.numGlobalNodes)))
       .add("elements", json::number(long(mesh_.numGlobalElements)))
       .add("dofs", json::number(long(3 * mesh_.numGlobalNodes)))
-      .add("contact_faces", json::number(0));
+      .add("contact_faces", json::number(numContactFaces_));
   Object top;
   top.add("title", json::string(scene_.title)).add("scene", json::string(scene_.file))
       .add("version", json::string(CAPSTAN_VERSION))
@@ -377,8 +537,6 @@ void Run::writeSummary(bool converged, const std::string& failure) {
 }
 
 int Run::execute() {
-  if (!scene_.capstans.empty())
-    throw InputError(scene_.file + ": parameter 'Capstans': contact is not available in this version");
   // Output directory: checked before any work, so bad input writes nothing.
   dir_ = scene_.outputDirectory;
   int dirOk = 1;
@@ -412,6 +570,8 @@ int Run::execute() {
   forceScale_ = scene_.c * size2;
   absTolerance_ = scene_.solver.get<double>("Newton Absolute Tolerance");
   if (absTolerance_ == 0) absTolerance_ = 1e-13 * forceScale_;
+  long localFaces = long(assembly_->contactFaceNodes().size() / 4);
+  Teuchos::reduceAll(*comm_, Teuchos::REDUCE_SUM, localFaces, Teuchos::outArg(numContactFaces_));
 
   if (scene_.writeFields) {
     FieldLayout layout;
@@ -433,11 +593,19 @@ int Run::execute() {
     fileIdOverlap.doImport(fileId, Tpetra::Import<>(mesh_.ownedNodeMap, mesh_.overlapNodeMap), Tpetra::INSERT);
     auto ids = fileIdOverlap.getData();
     for (int n : mesh_.connectivity) layout.hexConnectivity.push_back((long long)ids[n]);
+    // Contact-face grid: the union of the capstans' candidate faces.
+    long long faces = localFaces;
+    MPI_Exscan(&faces, &layout.faceOffset, 1, MPI_LONG_LONG, MPI_SUM, layout.comm);
+    if (comm_->getRank() == 0) layout.faceOffset = 0;
+    layout.facesOwned = faces;
+    layout.facesGlobal = numContactFaces_;
+    for (int n : assembly_->contactFaceNodes()) layout.quadConnectivity.push_back((long long)ids[n]);
     writer_ = std::make_unique<FieldWriter>(dir_.string(), layout);
   }
 
   const int N = scene_.steps;
   const double dt = scene_.stepSize;
+  assembly_->setInterval(0, 0);
   assembly_->evaluate(*u_, nullptr, nullptr);
   writeFields(0, 0.0);
   double tDone = 0;
@@ -453,14 +621,13 @@ int Run::execute() {
     // The last written step's state: a failed step's converged sub-steps are
     // not outputs, so the final figures go back to it.
     Vector uStep(*u_, Teuchos::Copy);
-    Kokkos::View<double*> pStep("pbar at step start", assembly_->bricks().pressureAnchor.extent(0));
-    Kokkos::deep_copy(pStep, assembly_->bricks().pressureAnchor);
+    const auto mStep = saveMultipliers();
+    const double tStep0 = tDone;
     const double hMin = dt / 1024;
     while (tDone < rec.time - 1e-12 * dt) {
       const double tEnd = std::min(tDone + h, rec.time);
       Vector uSaved(*u_, Teuchos::Copy);
-      Kokkos::View<double*> pSaved("pbar saved", assembly_->bricks().pressureAnchor.extent(0));
-      Kokkos::deep_copy(pSaved, assembly_->bricks().pressureAnchor);
+      const auto mSaved = saveMultipliers();
       std::string why;
       if (solveAt(tDone, tEnd, rec, why)) {
         tDone = tEnd;
@@ -468,7 +635,7 @@ int Run::execute() {
         continue;
       }
       u_->update(1.0, uSaved, 0.0);
-      Kokkos::deep_copy(assembly_->bricks().pressureAnchor, pSaved);
+      restoreMultipliers(mSaved);
       ++rec.cutbacks;
       h /= 2;
       if (!opt_.quiet && rank0_)
@@ -478,7 +645,9 @@ int Run::execute() {
                   Teuchos::toString(hMin) + ": " + why;
         ok = false;
         u_->update(1.0, uStep, 0.0);
-        Kokkos::deep_copy(assembly_->bricks().pressureAnchor, pStep);
+        restoreMultipliers(mStep);
+        tDone = tStep0;
+        assembly_->setInterval(tDone, tDone);
         break;
       }
     }
@@ -495,8 +664,8 @@ int Run::execute() {
     writeHistory();
     if (!opt_.quiet && rank0_) {
       std::printf("step %d/%d  t=%.4g  newton=%d  linear=%d  |R|=%.3e  dV=%.1e  max_penetration=%.3e  %.2fs\n",
-                  step, N, rec.time, rec.newton, rec.linear, rec.residual, rec.volumeChange, 0.0,
-                  since(t0_));
+                  step, N, rec.time, rec.newton, rec.linear, rec.residual, rec.volumeChange,
+                  rec.maxPenetration(), since(t0_));
       std::fflush(stdout);
     }
   }
