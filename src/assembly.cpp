@@ -52,8 +52,10 @@ Assembly::Assembly(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
     set.axisPoint = c.axisPoint;
     set.axisDirection = c.axisDirection;
     set.velocity = c.velocity;
-    set.solvePenalty = std::max(c.penalty, c.minimumSolvePenalty);
-    set.compliance = c.method == "Augmented Lagrangian" ? 0.0 : c.penalty;
+    set.penalty = c.penalty;
+    set.exact = c.method == "Augmented Lagrangian";
+    set.minimumSolvePenalty = c.minimumSolvePenalty;
+    set.c = scene.c;
     set.tolerance = c.penetrationTolerance;
     set.maxAugmentations = c.maxAugmentations;
     set.rule = c.quadrature;

@@ -216,20 +216,28 @@ ContactEffect::ContactEffect(const std::string& name, const Mesh& mesh,
   local_.R = Matrix("contact R", nf, 12);
   local_.K = Tensor3("contact K", nf, 12, 12);
   local_.active = Kokkos::View<int*>("contact active", nf);
-  if (settings_.tolerance <= 0) {
-    // Default: 1e-4 x the smallest candidate face edge, over all ranks.
-    double h = 1e300;
-    for (size_t f = 0; f < nf; ++f)
-      for (int a = 0; a < 4; ++a) {
-        const int n0 = quads[4 * f + a], n1 = quads[4 * f + (a + 1) % 4];
-        double l2 = 0;
-        for (int i = 0; i < 3; ++i) l2 += std::pow(mesh.X[3 * n1 + i] - mesh.X[3 * n0 + i], 2);
-        h = std::min(h, std::sqrt(l2));
-      }
-    double global = h;
-    Teuchos::reduceAll(*mesh.comm, Teuchos::REDUCE_MIN, h, Teuchos::outArg(global));
-    settings_.tolerance = 1e-4 * global;
-  }
+  // The smallest candidate face edge over all ranks sets the defaults.
+  double h = 1e300;
+  for (size_t f = 0; f < nf; ++f)
+    for (int a = 0; a < 4; ++a) {
+      const int n0 = quads[4 * f + a], n1 = quads[4 * f + (a + 1) % 4];
+      double l2 = 0;
+      for (int i = 0; i < 3; ++i) l2 += std::pow(mesh.X[3 * n1 + i] - mesh.X[3 * n0 + i], 2);
+      h = std::min(h, std::sqrt(l2));
+    }
+  double hMin = h;
+  Teuchos::reduceAll(*mesh.comm, Teuchos::REDUCE_MIN, h, Teuchos::outArg(hMin));
+  if (settings_.tolerance <= 0) settings_.tolerance = 1e-4 * hMin;
+  // Automatic floor for the nodal rule only: with Gauss points the penalty
+  // answer approaches an over-constrained one as eps2 -> 0 (flat faces cannot
+  // touch a curved capstan at every Gauss point), and the multiplier loop
+  // crawls (measured on G1: eps2 = 1e-4 needed 100+ passes per step).
+  const bool nodal = kernels::FaceRule(settings_.rule) == kernels::FaceRule::Nodal;
+  const double floor = settings_.minimumSolvePenalty >= 0 ? settings_.minimumSolvePenalty
+                       : nodal                            ? 1e-2 * hMin / settings_.c
+                                                          : 0.0;
+  solvePenalty_ = std::max(settings_.penalty, floor);
+  compliance_ = settings_.exact ? 0.0 : settings_.penalty;
 }
 
 void ContactEffect::setInterval(double, double tEnd) { time_ = tEnd; }
@@ -248,7 +256,7 @@ void ContactEffect::launch(const NodalVectors& x, const NodalVectors&, bool tang
     cyl.b[i] = beta_[i];
   }
   cyl.R = settings_.radius;
-  const double eps = settings_.solvePenalty, kappa = settings_.compliance;
+  const double eps = solvePenalty_, kappa = compliance_;
   const auto rule = kernels::FaceRule(settings_.rule);
   const bool geometric = geometric_;
   Kokkos::parallel_for(
@@ -305,7 +313,7 @@ double ContactEffect::constraintViolation() const {
   auto pts = points_;
   auto lambda = lambda_;
   const int nq = kernels::facePointCount(kernels::FaceRule(settings_.rule));
-  const double eps = settings_.solvePenalty;
+  const double eps = solvePenalty_;
   double v = 0;
   Kokkos::parallel_reduce(
       "contact violation", Kokkos::RangePolicy<ExecSpace>(0, pts.extent(0)),

@@ -129,8 +129,14 @@ class ContactEffect : public Effect {
   struct Settings {
     double radius = 1;
     std::array<double, 3> axisPoint{}, axisDirection{0, 0, 1}, velocity{};
-    double solvePenalty = 1e-3;  // eps of the Newton solves
-    double compliance = 1e-3;    // kappa: g = kappa t_n at the fixed point (0: exact contact)
+    double penalty = 1e-3;       // eps2 of the scene
+    bool exact = false;          // augmented Lagrangian: g = 0 (else the penalty answer g = eps2 t_n)
+    // Newton solves use eps = max(eps2, this); < 0: automatic, for the nodal
+    // rule 1e-2 h / c (h the smallest candidate face edge), a penalty 100 times
+    // stiffer than the body's surface, so the multiplier loop gains about two
+    // digits per pass; for Gauss rules 0.
+    double minimumSolvePenalty = -1;
+    double c = 1;                // the body's material constant
     double tolerance = 0;        // on eps |t_n - lambda| (length); 0 = 1e-4 x smallest edge
     int maxAugmentations = 50;
     int rule = 0;                // kernels::FaceRule
@@ -141,7 +147,8 @@ class ContactEffect : public Effect {
   void setInterval(double tStart, double tEnd) override;
   // Multipliers only where they change the answer: the augmented Lagrangian,
   // or a penalty solved at a larger penalty than the scene's.
-  bool augmented() const { return settings_.compliance < settings_.solvePenalty; }
+  bool augmented() const { return compliance_ < solvePenalty_; }
+  double solvePenalty() const { return solvePenalty_; }
   Kokkos::View<double*> multipliers() override {
     return augmented() ? lambda_ : Kokkos::View<double*>();
   }
@@ -190,6 +197,8 @@ class ContactEffect : public Effect {
   std::array<double, 3> beta_{};  // unit axis direction
   double time_ = 0;
   bool geometric_ = true;
+  double solvePenalty_ = 1e-3;  // eps of the Newton solves
+  double compliance_ = 1e-3;    // kappa: g = kappa t_n at the fixed point (0: exact contact)
 };
 
 }  // namespace capstan

@@ -65,12 +65,15 @@ ParameterList validParameters() {
   contact.set("Method", std::string("Penalty"), "Penalty | Augmented Lagrangian");
   contact.set("Penalty", 1e-3, "eps2 > 0: penetration per unit contact pressure");
   contact.set("Penetration Tolerance", 0.0,
-              "Augmented Lagrangian: stop when max penetration is below this; 0 = 1e-4 x the "
-              "smallest contact-face edge");
+              "Multiplier loop (augmented Lagrangian, or a penalty solved at a larger penalty): "
+              "stop when the penetration (or its error against the penalty answer) is below "
+              "this; 0 = 1e-4 x the smallest candidate face edge");
   contact.set("Max Augmentations", 50, "Augmented Lagrangian: most multiplier updates per step");
-  contact.set("Minimum Solve Penalty", 0.0,
-              "Newton solves use eps = max(Penalty, this); multiplier updates then reach the "
-              "answer of Penalty (a well-conditioned solve for a tiny penalty); 0 = off");
+  contact.set("Minimum Solve Penalty", -1.0,
+              "Newton solves use eps = max(Penalty, this), and multiplier updates then reach the "
+              "answer of Penalty (or exact contact): a well-conditioned solve for any Penalty. "
+              "< 0: automatic, 1e-2 h / c with the Nodal rule (h the smallest candidate face edge), "
+              "off with Gauss rules; 0: off");
   contact.set("Quadrature", std::string("Auto"),
               "Contact points per face: Auto | Gauss 2x2 | Gauss 3x3 | Nodal (at the face's nodes). "
               "Auto: Gauss 2x2 for Penalty, Nodal for Augmented Lagrangian (exact contact at every "
@@ -372,8 +375,8 @@ Scene loadScene(const std::string& file, const std::vector<std::string>& sets,
     cs.penetrationTolerance = ct.get<double>("Penetration Tolerance");
     if (!(cs.penetrationTolerance >= 0)) v.fail(path + "/Contact/Penetration Tolerance", "must be >= 0");
     cs.minimumSolvePenalty = ct.get<double>("Minimum Solve Penalty");
-    if (!(cs.minimumSolvePenalty >= 0) || !std::isfinite(cs.minimumSolvePenalty))
-      v.fail(path + "/Contact/Minimum Solve Penalty", "must be >= 0");
+    if (!std::isfinite(cs.minimumSolvePenalty))
+      v.fail(path + "/Contact/Minimum Solve Penalty", "must be a finite number");
     const std::string rule = ct.get<std::string>("Quadrature");
     if (rule == "Auto") cs.quadrature = cs.method == "Augmented Lagrangian" ? 2 : 0;
     else if (rule == "Gauss 2x2") cs.quadrature = 0;
