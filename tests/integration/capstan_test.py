@@ -180,9 +180,10 @@ def summary_figures(summary):
             disp[f"node_displacement_mean.{face}[{'xyz'[i]}]"] = x
     force = {}
     for st in summary["steps"]:
-        for name, s in st["supports"].items():
-            for i, x in enumerate(s["force"]):
-                force[f"step {st['step']} supports.{name}.force[{'xyz'[i]}]"] = x
+        for kind in ("supports", "capstans"):
+            for name, s in st.get(kind, {}).items():
+                for i, x in enumerate(s["force"]):
+                    force[f"step {st['step']} {kind}.{name}.force[{'xyz'[i]}]"] = x
     return {"stress": stress, "displacement": disp, "force": force}
 
 
@@ -226,19 +227,28 @@ class SceneInfo:
 # -- fields.h5 ---------------------------------------------------------------
 def read_fields(path):
     """{step number: {"X": reference coordinates, "u": displacement, "x": coordinates,
-    "stress": element stresses}} from fields.h5 (needs h5py and numpy)."""
+    "stress": element stresses, "pressure", "hexahedra": connectivity, "quads":
+    contact-face connectivity (or None), "faces": {name: contact-face field}}} from
+    fields.h5 (needs h5py and numpy)."""
     import h5py
     import numpy as np
     out = {}
     with h5py.File(path, "r") as f:
         steps = sorted(f["steps"].keys())
         X = np.array(f["steps"][steps[0]]["coordinates"])
+        hexes = np.array(f["mesh"]["hexahedra"])
+        quads = np.array(f["mesh"]["quads"]) if "quads" in f["mesh"] else None
         for s in steps:
             g = f["steps"][s]
+            faces = {}
+            for k, v in (g["faces"].items() if "faces" in g else []):
+                a = np.array(v)
+                faces[k] = a.reshape(-1) if a.ndim == 2 and a.shape[1] == 1 else a  # scalars as 1-D
             out[int(s)] = {"X": X, "x": np.array(g["coordinates"]),
                            "u": np.array(g["nodes"]["displacement"]),
                            "stress": np.array(g["elements"]["stress"]),
-                           "pressure": np.array(g["elements"]["pressure"])}
+                           "pressure": np.array(g["elements"]["pressure"]),
+                           "hexahedra": hexes, "quads": quads, "faces": faces}
     return out
 
 

@@ -2,11 +2,12 @@
 """A distributed run gives the results of a serial one (interface.md: "mpiexec -n 2
 capstan run SCENE.xml  # distributed run, same results as one rank").
 
-inputs/uniaxial.xml and inputs/shear.xml on 1 and 2 ranks:
+inputs/uniaxial.xml, inputs/shear.xml and G1 (inputs/seed/g1.xml, contact with the
+augmented Lagrangian) on 1 and 2 ranks:
   * summary.json: "ranks" is 1 and 2; both converge with the same number of steps;
   * final stress, pressure and von Mises extrema, the face means of the
-    displacement and every support force of every step agree to 1e-8 relative to
-    the largest magnitude of their kind;
+    displacement and every support and capstan force of every step agree to 1e-8
+    relative to the largest magnitude of their kind;
   * fields.h5: the final displacement of every node, matched by its reference
     coordinates (node order depends on the partition), agrees to 1e-8 x max |u|.
 """
@@ -20,11 +21,11 @@ from capstan_test import Test, by_reference_coordinates, read_fields, summary_fi
 TOL = 1e-8
 T = Test("ranks_agree", __doc__)
 
-for name in ("uniaxial.xml", "shear.xml"):
+for name in ("uniaxial.xml", "shear.xml", "seed/g1.xml"):
     scene = T.input(name)
     results = {}
     for ranks in (1, 2):
-        p, s, out = T.run_scene(scene, f"{name[:-4]}-{ranks}", ranks=ranks)
+        p, s, out = T.run_scene(scene, f"{os.path.basename(name)[:-4]}-{ranks}", ranks=ranks)
         if s is None:
             T.check(False, f"{name} on {ranks} rank(s): no summary.json")
             continue
