@@ -478,7 +478,8 @@ TEST_F(SceneTest, ShippedInputsValidate) {
   // The scenes in inputs/ that the integration tests run all load
   // (CAPSTAN_INPUTS_DIR is set by CMake).
 #ifdef CAPSTAN_INPUTS_DIR
-  for (const char* name : {"uniaxial.xml", "shear.xml", "default.xml"}) {
+  for (const char* name : {"uniaxial.xml", "shear.xml", "default.xml", "block40.xml", "seed/g1.xml",
+                           "seed/g2.xml", "seed/g3.xml"}) {
     const std::string file = std::string(CAPSTAN_INPUTS_DIR) + "/" + name;
     EXPECT_NO_THROW(loadScene(file, {}, "")) << file;
   }
@@ -486,5 +487,42 @@ TEST_F(SceneTest, ShippedInputsValidate) {
   GTEST_SKIP() << "CAPSTAN_INPUTS_DIR not defined";
 #endif
 }
+
+// ---------------------------------------------------------------------------
+// Capstans
+
+#ifdef CAPSTAN_INPUTS_DIR
+TEST_F(SceneTest, CapstanOfG1) {
+  const Scene s = loadScene(std::string(CAPSTAN_INPUTS_DIR) + "/seed/g1.xml", {}, "");
+  ASSERT_EQ(s.capstans.size(), 1u);
+  const auto& c = s.capstans[0];
+  EXPECT_EQ(c.name, "capstan");
+  EXPECT_EQ(c.radius, 2.0);
+  EXPECT_EQ(c.axisPoint, (std::array<double, 3>{3.5, 3.75, 0}));
+  EXPECT_EQ(c.axisDirection, (std::array<double, 3>{0, 0, 1}));
+  EXPECT_EQ(c.velocity, (std::array<double, 3>{0, -0.1, 0}));
+  EXPECT_EQ(c.contactFaces, (std::vector<std::string>{"ymax"}));
+  EXPECT_EQ(c.method, "Augmented Lagrangian");
+  EXPECT_EQ(c.quadrature, 2) << "Auto: the augmented Lagrangian uses the nodal rule";
+  EXPECT_LT(c.minimumSolvePenalty, 0) << "automatic solve penalty by default";
+  const Scene p = loadScene(std::string(CAPSTAN_INPUTS_DIR) + "/seed/g1.xml",
+                            {"Capstans/capstan/Contact/Method=Penalty"}, "");
+  EXPECT_EQ(p.capstans[0].quadrature, 0) << "Auto: the penalty method uses Gauss 2x2";
+}
+
+TEST_F(SceneTest, CapstanInputErrors) {
+  const std::string g1 = std::string(CAPSTAN_INPUTS_DIR) + "/seed/g1.xml";
+  const std::string C = "Capstans/capstan/";
+  expectInputError(g1, {C + "Radius"}, {C + "Radius=0"});
+  expectInputError(g1, {C + "Axis Direction", "non-zero"}, {C + "Axis Direction={0,0,0}"});
+  expectInputError(g1, {C + "Contact Faces", "'top'"}, {C + "Contact Faces=top"});
+  expectInputError(g1, {C + "Contact/Method", "'Lagrange'"}, {C + "Contact/Method=Lagrange"});
+  expectInputError(g1, {C + "Contact/Penalty"}, {C + "Contact/Penalty=-1e-3"});
+  expectInputError(g1, {C + "Contact/Quadrature", "'Gauss 4x4'"}, {C + "Contact/Quadrature=Gauss 4x4"});
+  expectInputError(g1, {C + "Contact/Quadrature", "Nodal"}, {C + "Contact/Quadrature=Gauss 2x2"});
+  expectInputError(g1, {C + "Contact/Max Augmentations"}, {C + "Contact/Max Augmentations=0"});
+  expectInputError(g1, {C + "Friction/Law"}, {C + "Friction/Law=Tanh"});
+}
+#endif
 
 }  // namespace
