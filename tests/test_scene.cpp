@@ -478,7 +478,7 @@ TEST_F(SceneTest, ShippedInputsValidate) {
   // The scenes in inputs/ that the integration tests run all load
   // (CAPSTAN_INPUTS_DIR is set by CMake).
 #ifdef CAPSTAN_INPUTS_DIR
-  for (const char* name : {"uniaxial.xml", "shear.xml", "default.xml", "block40.xml", "seed/g1.xml",
+  for (const char* name : {"uniaxial.xml", "shear.xml", "default.xml", "squeeze.xml", "block40.xml", "seed/g1.xml",
                            "seed/g2.xml", "seed/g3.xml"}) {
     const std::string file = std::string(CAPSTAN_INPUTS_DIR) + "/" + name;
     EXPECT_NO_THROW(loadScene(file, {}, "")) << file;
