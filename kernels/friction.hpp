@@ -29,6 +29,10 @@ struct FrictionParameters {
   double tangentPenalty = 1e-3;  // Coulomb: eps_t, slip per unit traction while sticking
   double ds[3] = {0, 0, 0};    // translation of the capstan in the increment
   double spin = 0;             // omega dt R: surface travel of the turning capstan
+  // Step predictor only: every point sticks (Coulomb: the trial traction, no
+  // return mapping; regularised laws: their zero-slip slope, t = mu t_n du_t / v),
+  // so the linear response moves the body with the capstan where friction holds.
+  bool stickPredictor = false;
 };
 
 // psi(s) = phi(s) / s and chi(s) = psi'(s) / s of a regularised law, finite at
@@ -65,6 +69,7 @@ struct FrictionPoint {
   double slip = 0;                 // |du_t|
   int state = 0;                   // 0 no contact, 1 stick, 2 slip
   double weight = 0;               // quadrature weight x reference area element
+  double e[3] = {0, 0, 0};         // unit vector from the axis towards the point
 };
 
 // Residual (R_a = -sum_q w N_a t_f) and tangent (if K is not null) of one face.
@@ -110,6 +115,7 @@ KOKKOS_INLINE_FUNCTION bool frictionFaceResidualTangent(
     const double tn = lambda[q] + (g - kappa * lambda[q]) / eps;
     if (!(tn > 0)) continue;
     p.normal = tn;
+    for (int i = 0; i < 3; ++i) p.e[i] = e[i];
 
     // Slip in the increment and its derivatives with respect to the point x.
     const double tau[3] = {b[1] * e[2] - b[2] * e[1], b[2] * e[0] - b[0] * e[2],
@@ -154,7 +160,7 @@ KOKKOS_INLINE_FUNCTION bool frictionFaceResidualTangent(
           Tr[i][j] = -e[i] * hE[j] - eh * E[i][j] + Dt[i][j] / fp.tangentPenalty;
       }
       const double mag = sqrt(tr[0] * tr[0] + tr[1] * tr[1] + tr[2] * tr[2]);
-      if (mag <= fp.mu * tn) {  // stick
+      if (mag <= fp.mu * tn || fp.stickPredictor) {  // stick
         p.state = 1;
         for (int i = 0; i < 3; ++i) {
           t[i] = tr[i];
@@ -175,7 +181,8 @@ KOKKOS_INLINE_FUNCTION bool frictionFaceResidualTangent(
       }
     } else {
       double psi, chi;
-      regularisedLaw(fp.law, slip, fp.v, psi, chi);
+      regularisedLaw(fp.law, fp.stickPredictor ? 0.0 : slip, fp.v, psi, chi);
+      if (fp.stickPredictor) chi = 0;
       p.state = slip <= fp.v ? 1 : 2;  // within the regularisation: counted as stick
       double dutDt[3];
       for (int j = 0; j < 3; ++j) dutDt[j] = dut[0] * Dt[0][j] + dut[1] * Dt[1][j] + dut[2] * Dt[2][j];

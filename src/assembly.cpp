@@ -79,7 +79,21 @@ Assembly::Assembly(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
     }
     auto effect = std::make_unique<ContactEffect>("contact:" + c.name, mesh, quads, set);
     contacts_.push_back(effect.get());
+    frictions_.push_back(nullptr);
+    const ContactEffect& contact = *effect;
     effects_.push_back(std::move(effect));
+    if (c.frictionLaw == "None") continue;  // no friction kernel at all
+    FrictionEffect::Settings fs;
+    fs.law = c.frictionLaw == "Tanh"     ? kernels::FrictionLaw::Tanh
+             : c.frictionLaw == "Arctan" ? kernels::FrictionLaw::Arctan
+                                         : kernels::FrictionLaw::Coulomb;
+    fs.mu = c.frictionCoefficient;
+    fs.regularization = c.regularization;
+    fs.tangentPenalty = c.tangentialPenalty;
+    fs.angularVelocity = c.angularVelocity;
+    auto friction = std::make_unique<FrictionEffect>("friction:" + c.name, mesh, quads, contact, fs);
+    frictions_.back() = friction.get();
+    effects_.push_back(std::move(friction));
   }
 
   // Graph from every effect's entities: built once, fixed sparsity.

@@ -47,6 +47,8 @@ class Assembly {
   const std::vector<std::unique_ptr<Effect>>& effects() const { return effects_; }
   const std::vector<FoundationEffect*>& foundations() const { return foundations_; }
   const std::vector<ContactEffect*>& contacts() const { return contacts_; }
+  // Per capstan (as contacts()): its friction effect, or null without friction.
+  const std::vector<FrictionEffect*>& frictions() const { return frictions_; }
   // The union of all capstans' candidate faces on this rank (4 overlapped node
   // ids each), and for capstan i the union index of each of its faces.
   const std::vector<int>& contactFaceNodes() const { return contactFaceNodes_; }
@@ -89,6 +91,7 @@ class Assembly {
   BrickEffect* bricks_ = nullptr;
   std::vector<FoundationEffect*> foundations_;
   std::vector<ContactEffect*> contacts_;
+  std::vector<FrictionEffect*> frictions_;
   std::map<std::array<int, 4>, int> contactFaceIndex_;
   std::vector<int> contactFaceNodes_;
   std::vector<std::vector<int>> contactFaceOf_;

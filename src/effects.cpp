@@ -242,6 +242,16 @@ ContactEffect::ContactEffect(const std::string& name, const Mesh& mesh,
 
 void ContactEffect::setInterval(double, double tEnd) { time_ = tEnd; }
 
+kernels::Cylinder ContactEffect::cylinder() const {
+  kernels::Cylinder cyl;
+  for (int i = 0; i < 3; ++i) {
+    cyl.a[i] = settings_.axisPoint[i] + settings_.velocity[i] * time_;
+    cyl.b[i] = beta_[i];
+  }
+  cyl.R = settings_.radius;
+  return cyl;
+}
+
 void ContactEffect::launch(const NodalVectors& x, const NodalVectors&, bool tangent) {
   auto nodes = nodes_;
   auto X = X_;
@@ -250,15 +260,10 @@ void ContactEffect::launch(const NodalVectors& x, const NodalVectors&, bool tang
   auto active = local_.active;
   auto lambda = lambda_;
   auto pts = points_;
-  kernels::Cylinder cyl;
-  for (int i = 0; i < 3; ++i) {
-    cyl.a[i] = settings_.axisPoint[i] + settings_.velocity[i] * time_;
-    cyl.b[i] = beta_[i];
-  }
-  cyl.R = settings_.radius;
+  const kernels::Cylinder cyl = cylinder();
   const double eps = solvePenalty_, kappa = compliance_;
   const auto rule = kernels::FaceRule(settings_.rule);
-  const bool geometric = geometric_;
+  const bool geometric = !predicting_;
   Kokkos::parallel_for(
       "contact residual+tangent", Kokkos::RangePolicy<ExecSpace>(0, nodes.extent(0)),
       KOKKOS_LAMBDA(int f) {
@@ -380,6 +385,151 @@ void ContactEffect::faceFields(std::vector<double>& pressure, std::vector<double
     }
     pressure[f] /= area;
     for (int i = 0; i < 3; ++i) traction[3 * f + i] /= area;
+  }
+}
+
+// ---------------------------------------------------------------- friction
+
+namespace {
+constexpr int kHistoryPerFace = 12 + 3 * kernels::kMaxFacePoints;
+enum FrictionField { kTraction = 0, kNormal = 3, kSlip, kState, kFWeight, kFE };
+}  // namespace
+
+FrictionEffect::FrictionEffect(const std::string& name, const Mesh& mesh,
+                               const std::vector<int>& quads, const ContactEffect& contact,
+                               const Settings& settings)
+    : Effect(name), contact_(contact), settings_(settings) {
+  const size_t nf = quads.size() / 4;
+  loadEntities(mesh, quads, "friction", nodes_, X_);
+  history_ = Kokkos::View<double*>("friction history", nf * kHistoryPerFace);
+  points_ = decltype(points_)("friction points", nf, kernels::kMaxFacePoints);
+  local_.dofs = dofsOf(nodes_);
+  local_.R = Matrix("friction R", nf, 12);
+  local_.K = Tensor3("friction K", nf, 12, 12);
+  local_.active = Kokkos::View<int*>("friction active", nf);
+  // The body starts at its reference positions, with no friction traction.
+  auto X = X_;
+  auto h = history_;
+  Kokkos::parallel_for(
+      "friction history start", Kokkos::RangePolicy<ExecSpace>(0, nf), KOKKOS_LAMBDA(int f) {
+        for (int a = 0; a < 4; ++a)
+          for (int i = 0; i < 3; ++i) h(f * kHistoryPerFace + 3 * a + i) = X(f, a, i);
+      });
+  parameters_.law = settings.law;
+  parameters_.mu = settings.mu;
+  parameters_.tangentPenalty =
+      settings.tangentPenalty > 0 ? settings.tangentPenalty : contact.solvePenalty();
+}
+
+void FrictionEffect::setInterval(double tStart, double tEnd) {
+  const double dt = tEnd - tStart;
+  for (int i = 0; i < 3; ++i) parameters_.ds[i] = contact_.settings().velocity[i] * dt;
+  parameters_.spin = settings_.angularVelocity * dt * contact_.radius();
+  // The slip-length scale eps3 dt; a zero-length interval (a re-evaluation of a
+  // converged state) has no slip, any positive scale gives t_f = 0 there.
+  parameters_.v = settings_.regularization * (dt > 0 ? dt : 1.0);
+}
+
+void FrictionEffect::launch(const NodalVectors& x, const NodalVectors&, bool tangent) {
+  auto nodes = nodes_;
+  auto X = X_;
+  auto R = local_.R;
+  auto K = local_.K;
+  auto active = local_.active;
+  auto lambda = contact_.normalMultipliers();
+  auto h = history_;
+  auto pts = points_;
+  const kernels::Cylinder cyl = contact_.cylinder();
+  const double eps = contact_.solvePenalty(), kappa = contact_.compliance();
+  const auto rule = kernels::FaceRule(contact_.rule());
+  const kernels::FrictionParameters fp = parameters_;
+  Kokkos::parallel_for(
+      "friction residual+tangent", Kokkos::RangePolicy<ExecSpace>(0, nodes.extent(0)),
+      KOKKOS_LAMBDA(int f) {
+        double Xf[4][3], xf[4][3], xn[4][3];
+        for (int a = 0; a < 4; ++a)
+          for (int i = 0; i < 3; ++i) {
+            Xf[a][i] = X(f, a, i);
+            xf[a][i] = x(nodes(f, a), i);
+            xn[a][i] = h(f * kHistoryPerFace + 3 * a + i);
+          }
+        kernels::FrictionPoint p[kernels::kMaxFacePoints];
+        active(f) = kernels::frictionFaceResidualTangent(
+            Xf, xf, xn, cyl, eps, kappa, &lambda(f * kernels::kMaxFacePoints), rule, fp,
+            &h(f * kHistoryPerFace + 12), &R(f, 0), tangent ? &K(f, 0, 0) : nullptr, p);
+        for (int q = 0; q < kernels::facePointCount(rule); ++q) {
+          for (int i = 0; i < 3; ++i) pts(f, q, kTraction + i) = p[q].traction[i];
+          pts(f, q, kNormal) = p[q].normal;
+          pts(f, q, kSlip) = p[q].slip;
+          pts(f, q, kState) = p[q].state;
+          pts(f, q, kFWeight) = p[q].weight;
+          for (int i = 0; i < 3; ++i) pts(f, q, kFE + i) = p[q].e[i];
+        }
+      });
+}
+
+void FrictionEffect::commit(const NodalVectors& x) {
+  auto nodes = nodes_;
+  auto h = history_;
+  auto pts = points_;
+  const int nq = kernels::facePointCount(kernels::FaceRule(contact_.rule()));
+  Kokkos::parallel_for(
+      "friction commit", Kokkos::RangePolicy<ExecSpace>(0, nodes.extent(0)), KOKKOS_LAMBDA(int f) {
+        for (int a = 0; a < 4; ++a)
+          for (int i = 0; i < 3; ++i) h(f * kHistoryPerFace + 3 * a + i) = x(nodes(f, a), i);
+        for (int q = 0; q < nq; ++q)
+          for (int i = 0; i < 3; ++i) h(f * kHistoryPerFace + 12 + 3 * q + i) = pts(f, q, kTraction + i);
+      });
+}
+
+FrictionEffect::Figures FrictionEffect::figures() const {
+  auto pts = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), points_);
+  const int nq = kernels::facePointCount(kernels::FaceRule(contact_.rule()));
+  const auto b = contact_.axisDirection();
+  Figures fig;
+  for (size_t f = 0; f < pts.extent(0); ++f)
+    for (int q = 0; q < nq; ++q) {
+      const int state = int(pts(f, q, kState));
+      if (state == 0) continue;
+      (state == 1 ? fig.stick : fig.slip) += 1;
+      const double w = pts(f, q, kFWeight), tn = pts(f, q, kNormal);
+      const double* t = &pts(f, q, kTraction);
+      const double mag = std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+      fig.frictionIntegral += w * mag;
+      fig.normalIntegral += w * tn;
+      if (settings_.mu > 0) fig.maxRatio = std::max(fig.maxRatio, mag / (settings_.mu * tn));
+      // Force on the capstan -w t at radius R e: axial moment R (e x F) . b = R F . (b x e).
+      const double* e = &pts(f, q, kFE);
+      const double tau[3] = {b[1] * e[2] - b[2] * e[1], b[2] * e[0] - b[0] * e[2],
+                             b[0] * e[1] - b[1] * e[0]};
+      for (int i = 0; i < 3; ++i) {
+        fig.force[i] -= w * t[i];
+        fig.torque -= contact_.radius() * w * t[i] * tau[i];
+      }
+    }
+  return fig;
+}
+
+void FrictionEffect::faceFields(std::vector<double>& traction, std::vector<double>& stick,
+                                std::vector<double>& slip) const {
+  auto pts = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), points_);
+  const int nq = kernels::facePointCount(kernels::FaceRule(contact_.rule()));
+  const size_t nf = pts.extent(0);
+  traction.assign(3 * nf, 0.0);
+  stick.assign(nf, 0.0);
+  slip.assign(nf, 0.0);
+  for (size_t f = 0; f < nf; ++f) {
+    double area = 0;
+    for (int q = 0; q < nq; ++q) {
+      const double w = pts(f, q, kFWeight);
+      area += w;
+      for (int i = 0; i < 3; ++i) traction[3 * f + i] += w * pts(f, q, kTraction + i);
+      const int state = int(pts(f, q, kState));
+      if (state == 1) stick[f] += 1;
+      if (state == 2) slip[f] += 1;
+    }
+    if (area > 0)
+      for (int i = 0; i < 3; ++i) traction[3 * f + i] /= area;
   }
 }
 

@@ -6,6 +6,9 @@
 
 #include <Kokkos_Core.hpp>
 
+#include "../kernels/contact.hpp"
+#include "../kernels/friction.hpp"
+
 #include <array>
 #include <string>
 #include <vector>
@@ -54,6 +57,16 @@ class Effect {
   virtual Kokkos::View<double*> multipliers() { return {}; }
   // G(multipliers) at the last evaluation, into `next` (same size).
   virtual void multiplierMap(const Kokkos::View<double*>& /*next*/) const {}
+  // History: state from the last converged increment (friction's positions and
+  // stick tractions), changed only by commit(x) when an increment converges, at
+  // its converged positions x (the last evaluation).
+  virtual Kokkos::View<double*> history() { return {}; }
+  virtual void commit(const NodalVectors& /*x*/) {}
+
+  // The step predictor's evaluations: effects may use a simpler, more robust
+  // linearisation there (it is only a first guess; Newton's tangent is exact).
+  virtual void setPredicting(bool /*on*/) {}
+
   // Whether Anderson mixing may accelerate this effect's multiplier loop.
   virtual bool accelerated() const { return true; }
   // Brings mixed multipliers back into their admissible set (e.g. lambda >= 0).
@@ -179,9 +192,16 @@ class ContactEffect : public Effect {
                   std::vector<double>& traction) const;
   const std::array<double, 3>& axisDirection() const { return beta_; }
   double radius() const { return settings_.radius; }
-  // Geometric stiffness of the contact tangent on (default) or off (for a
-  // step predictor only, see kernels/contact.hpp).
-  void setGeometricStiffness(bool on) { geometric_ = on; }
+  // Predictor: the contact tangent without its geometric stiffness (see
+  // kernels/contact.hpp).
+  void setPredicting(bool on) override { predicting_ = on; }
+  // What friction on the same faces needs: the cylinder now, the normal
+  // multipliers, the penalties and the rule.
+  kernels::Cylinder cylinder() const;
+  Kokkos::View<double*> normalMultipliers() const { return lambda_; }
+  double compliance() const { return compliance_; }
+  int rule() const { return settings_.rule; }
+  const Settings& settings() const { return settings_; }
   size_t numFaces() const { return nodes_.extent(0); }
 
  protected:
@@ -196,9 +216,58 @@ class ContactEffect : public Effect {
   Settings settings_;
   std::array<double, 3> beta_{};  // unit axis direction
   double time_ = 0;
-  bool geometric_ = true;
+  bool predicting_ = false;
   double solvePenalty_ = 1e-3;  // eps of the Newton solves
   double compliance_ = 1e-3;    // kappa: g = kappa t_n at the fixed point (0: exact contact)
+};
+
+// Friction of one capstan on its contact faces (kernels/friction.hpp); reads
+// the normal contact state of its ContactEffect (same faces, same points).
+class FrictionEffect : public Effect {
+ public:
+  struct Settings {
+    kernels::FrictionLaw law = kernels::FrictionLaw::None;
+    double mu = 0;
+    double regularization = 1e-3;  // eps3 / eps4: slip speed scale
+    double tangentPenalty = 0;     // Coulomb eps_t; 0: the contact's solve penalty
+    double angularVelocity = 0;
+  };
+  FrictionEffect(const std::string& name, const Mesh& mesh, const std::vector<int>& quads,
+                 const ContactEffect& contact, const Settings& settings);
+
+  void setInterval(double tStart, double tEnd) override;
+  // Predictor: every contact point sticks (kernels/friction.hpp).
+  void setPredicting(bool on) override { parameters_.stickPredictor = on; }
+  Kokkos::View<double*> history() override { return history_; }
+  void commit(const NodalVectors& x) override;
+
+  struct Figures {
+    std::array<double, 3> force{};  // friction of the body on the capstan
+    double torque = 0;              // about the capstan's axis
+    long stick = 0, slip = 0;
+    double frictionIntegral = 0;    // sum of w |t_f|
+    double normalIntegral = 0;      // sum of w t_n
+    double maxRatio = 0;            // largest |t_f| / (mu t_n)
+  };
+  Figures figures() const;
+  // Per face: mean friction traction (3), stick and slip point counts.
+  void faceFields(std::vector<double>& traction, std::vector<double>& stick,
+                  std::vector<double>& slip) const;
+
+ protected:
+  void launch(const NodalVectors& x, const NodalVectors& u, bool tangent) override;
+
+ private:
+  const ContactEffect& contact_;
+  Kokkos::View<int* [4], Kokkos::LayoutRight> nodes_;
+  Kokkos::View<double* [4][3], Kokkos::LayoutRight> X_;
+  // [face][0..11]: node positions at the last converged state; then
+  // [face][12 + 3q + i]: Coulomb's traction at point q from that state.
+  Kokkos::View<double*> history_;
+  // Per face and point at the last evaluation: traction (3), t_n, slip, state, weight, e (3).
+  Kokkos::View<double** [10], Kokkos::LayoutRight> points_;
+  Settings settings_;
+  kernels::FrictionParameters parameters_;
 };
 
 }  // namespace capstan

@@ -82,6 +82,9 @@ ParameterList validParameters() {
   fr.set("Law", std::string("None"), "None | Tanh | Arctan | Coulomb");
   fr.set("Coefficient", 0.0, "mu >= 0");
   fr.set("Regularization", 1e-3, "eps3 (Tanh) or eps4 (Arctan) > 0: slip velocity scale");
+  fr.set("Tangential Penalty", 0.0,
+         "Coulomb: eps_t > 0, tangential slip per unit friction traction while sticking; "
+         "0 = the contact's solve penalty");
 
   auto& time = p.sublist("Time", false, "Quasi-static load steps t_n = n dt");
   time.set("Steps", 1, "Number of steps (>= 1)");
@@ -391,10 +394,18 @@ Scene loadScene(const std::string& file, const std::vector<std::string>& sets,
     if (cs.maxAugmentations < 1) v.fail(path + "/Contact/Max Augmentations", "must be >= 1");
     const auto& fr = c.sublist("Friction");
     cs.frictionLaw = fr.get<std::string>("Law");
-    if (cs.frictionLaw != "None")
-      v.fail(path + "/Friction/Law", "'" + cs.frictionLaw + "': friction is not available in this version (None only)");
+    if (cs.frictionLaw != "None" && cs.frictionLaw != "Tanh" && cs.frictionLaw != "Arctan" &&
+        cs.frictionLaw != "Coulomb")
+      v.fail(path + "/Friction/Law", "'" + cs.frictionLaw + "' is not a law (None, Tanh, Arctan, Coulomb)");
     cs.frictionCoefficient = fr.get<double>("Coefficient");
+    if (!(cs.frictionCoefficient >= 0) || !std::isfinite(cs.frictionCoefficient))
+      v.fail(path + "/Friction/Coefficient", "must be >= 0");
     cs.regularization = fr.get<double>("Regularization");
+    if (!(cs.regularization > 0) || !std::isfinite(cs.regularization))
+      v.fail(path + "/Friction/Regularization", "must be > 0");
+    cs.tangentialPenalty = fr.get<double>("Tangential Penalty");
+    if (!(cs.tangentialPenalty >= 0) || !std::isfinite(cs.tangentialPenalty))
+      v.fail(path + "/Friction/Tangential Penalty", "must be >= 0");
     sc.capstans.push_back(cs);
   }
 
@@ -414,6 +425,10 @@ Scene loadScene(const std::string& file, const std::vector<std::string>& sets,
     }
   };
   oneOf("Linear Solver", {"Auto", "GMRES", "CG", "Direct"});
+  for (const auto& c : sc.capstans)
+    if (c.frictionLaw != "None" && sol.get<std::string>("Linear Solver") == "CG")
+      v.fail("Solver/Linear Solver", "CG needs a symmetric matrix; friction on capstan '" + c.name +
+                                         "' makes it non-symmetric (use Auto, GMRES or Direct)");
   oneOf("Preconditioner", {"ILU", "Jacobi", "None"});
   oneOf("Line Search", {"Backtrack", "Polynomial", "Full Step"});
   oneOf("Predictor", {"Tangent", "Previous"});

@@ -34,7 +34,7 @@ struct CapstanSpec {
   int maxAugmentations = 0;
   int quadrature = 0;  // kernels::FaceRule: 0 Gauss 2x2, 1 Gauss 3x3, 2 Nodal
   std::string frictionLaw;  // None | Tanh | Arctan | Coulomb
-  double frictionCoefficient = 0, regularization = 0;
+  double frictionCoefficient = 0, regularization = 0, tangentialPenalty = 0;
 };
 
 struct Scene {
