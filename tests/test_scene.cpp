@@ -478,8 +478,9 @@ TEST_F(SceneTest, ShippedInputsValidate) {
   // The scenes in inputs/ that the integration tests run all load
   // (CAPSTAN_INPUTS_DIR is set by CMake).
 #ifdef CAPSTAN_INPUTS_DIR
-  for (const char* name : {"uniaxial.xml", "shear.xml", "default.xml", "squeeze.xml", "block40.xml", "seed/g1.xml",
-                           "seed/g2.xml", "seed/g3.xml"}) {
+  for (const char* name : {"uniaxial.xml", "shear.xml", "default.xml", "squeeze.xml", "block40.xml", "two-capstans.xml",
+                           "seed/g1.xml", "seed/g2.xml", "seed/g3.xml", "seed/h1.xml", "seed/h2.xml",
+                           "seed/h3.xml", "seed/h4.xml", "seed/h5.xml", "seed/h4-study.xml", "seed/h5-study.xml"}) {
     const std::string file = std::string(CAPSTAN_INPUTS_DIR) + "/" + name;
     EXPECT_NO_THROW(loadScene(file, {}, "")) << file;
   }
@@ -521,7 +522,11 @@ TEST_F(SceneTest, CapstanInputErrors) {
   expectInputError(g1, {C + "Contact/Quadrature", "'Gauss 4x4'"}, {C + "Contact/Quadrature=Gauss 4x4"});
   expectInputError(g1, {C + "Contact/Quadrature", "Nodal"}, {C + "Contact/Quadrature=Gauss 2x2"});
   expectInputError(g1, {C + "Contact/Max Augmentations"}, {C + "Contact/Max Augmentations=0"});
-  expectInputError(g1, {C + "Friction/Law"}, {C + "Friction/Law=Tanh"});
+  expectInputError(g1, {C + "Friction/Law", "'Stribeck'"}, {C + "Friction/Law=Stribeck"});
+  expectInputError(g1, {C + "Friction/Coefficient"}, {C + "Friction/Law=Tanh", C + "Friction/Coefficient=-0.1"});
+  expectInputError(g1, {C + "Friction/Regularization"}, {C + "Friction/Law=Tanh", C + "Friction/Regularization=0"});
+  expectInputError(g1, {"Solver/Linear Solver", "non-symmetric"},
+                   {C + "Friction/Law=Coulomb", "Solver/Linear Solver=CG"});
 }
 #endif
 

@@ -3,7 +3,7 @@
 capstan run SCENE.xml  # distributed run, same results as one rank").
 
 inputs/uniaxial.xml, inputs/shear.xml and G1 (inputs/seed/g1.xml, contact with the
-augmented Lagrangian) on 1 and 2 ranks:
+augmented Lagrangian), H1 (tanh friction) and H5 (Coulomb friction) on 1 and 2 ranks:
   * summary.json: "ranks" is 1 and 2; both converge with the same number of steps;
   * final stress, pressure and von Mises extrema, the face means of the
     displacement and every support and capstan force of every step agree to 1e-8
@@ -21,7 +21,7 @@ from capstan_test import Test, by_reference_coordinates, read_fields, summary_fi
 TOL = 1e-8
 T = Test("ranks_agree", __doc__)
 
-for name in ("uniaxial.xml", "shear.xml", "seed/g1.xml"):
+for name in ("uniaxial.xml", "shear.xml", "seed/g1.xml", "seed/h1.xml", "seed/h5.xml"):
     scene = T.input(name)
     results = {}
     for ranks in (1, 2):

@@ -1,0 +1,94 @@
+#!/usr/bin/env python3
+"""Rolling contact with friction, the study's H cases (formulation.md §6,
+inputs/seed/h1.xml ... h5.xml).
+
+  * every scene converges and conforms; effects are brick, the foundation, contact and
+    friction (each capstan's friction is its own effect);
+  * H1 full-slip balance at every step: the capstan's x force equals the foundation's
+    reaction (1e-8 relative), and the integral of the friction traction equals mu times
+    the integral of the normal traction (1e-6: friction fully mobilised), every contact
+    point slipping;
+  * H1 (tanh) and H2 (arctan) agree within 1% on the final capstan force and the xmin
+    mean displacement;
+  * H3: Regularization 1e-15, 1e-9, 1e-3, 1: every run converges, and the final capstan
+    force and xmin mean displacement vary by less than 1%;
+  * H4 (k = 0.1) and H5 (mu = 0.9), capstan's method (augmented Lagrangian, Coulomb):
+    converge with max_penetration below 1e-3 at every step, the friction traction never
+    above mu t_n (ratio <= 1 + 1e-8), no NaN; the study's loosened penalties
+    (h4-study.xml, h5-study.xml) are run and their penetrations printed beside them.
+"""
+import os
+import sys
+
+sys.dont_write_bytecode = True
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from capstan_test import Test, has_nan  # noqa: E402
+
+T = Test("friction_h", __doc__)
+F = "Capstans/capstan/Friction/"
+
+
+def run(name, sets=(), tag=None):
+    scene = T.input(f"seed/{name}.xml")
+    p, s, out = T.run_scene(scene, tag or name, sets=sets)
+    if s is None or not s["converged"]:
+        T.check(False, f"{tag or name}: converged ({None if s is None else s['failure']!r})")
+        return None
+    T.conforms(out, scene)
+    T.check(not has_nan(s), f"{tag or name}: no NaN in summary.json")
+    c = s["steps"][-1]["capstans"]["capstan"]
+    print(f"    {tag or name:14s} force = [{c['force'][0]:.8f}, {c['force'][1]:.8f}]  "
+          f"xmin u_x = {s['final']['node_displacement_mean']['xmin'][0]:.8f}  "
+          f"max_penetration = {max(st['capstans']['capstan']['max_penetration'] for st in s['steps']):.3e}  "
+          f"stick/slip = {c['stick_points']}/{c['slip_points']}  "
+          f"newton = {[st['newton_iterations'] for st in s['steps']]}  wall = {s['timing']['total']:.2f} s")
+    return s
+
+
+def final(s):
+    return (s["steps"][-1]["capstans"]["capstan"]["force"][0], s["final"]["node_displacement_mean"]["xmin"][0])
+
+
+h1 = run("h1")
+if h1:
+    T.check(sorted(h1["effects"]) == ["brick", "contact:capstan", "foundation:foundation", "friction:capstan"],
+            f"H1 effects: {sorted(h1['effects'])}")
+    for st in h1["steps"]:
+        c = st["capstans"]["capstan"]
+        fx, rx = c["force"][0], st["supports"]["foundation"]["force"][0]
+        T.check(abs(fx - rx) <= 1e-8 * abs(rx), f"H1 step {st['step']}: capstan x force {fx:.12g} = foundation {rx:.12g}")
+        fr = c["friction"]
+        ratio = fr["traction_integral"] / (0.1 * fr["normal_traction_integral"])
+        T.check(abs(ratio - 1) <= 1e-6, f"H1 step {st['step']}: friction integral / (mu x normal integral) = {ratio:.9f}")
+        T.check(c["slip_points"] == c["contact_points"] > 0 and c["stick_points"] == 0,
+                f"H1 step {st['step']}: all {c['contact_points']} contact points slip ({c['slip_points']})")
+
+h2 = run("h2")
+if h1 and h2:
+    (f1, u1), (f2, u2) = final(h1), final(h2)
+    T.check(abs(f2 - f1) <= 0.01 * abs(f1) and abs(u2 - u1) <= 0.01 * abs(u1),
+            f"H1 vs H2: force x {f1:.6g} vs {f2:.6g}, xmin u_x {u1:.6g} vs {u2:.6g} (1%)")
+
+h3 = {}
+for reg in ("1e-15", "1e-9", "1e-3", "1"):
+    s = run("h3", [f"{F}Regularization={reg}"], tag=f"h3 reg={reg}")
+    if s:
+        h3[reg] = final(s)
+if len(h3) == 4:
+    fs, us = [v[0] for v in h3.values()], [v[1] for v in h3.values()]
+    T.check((max(fs) - min(fs)) <= 0.01 * max(abs(x) for x in fs) and (max(us) - min(us)) <= 0.01 * max(abs(x) for x in us),
+            f"H3: force x in [{min(fs):.8g}, {max(fs):.8g}], xmin u_x in [{min(us):.8g}, {max(us):.8g}] (1%)")
+
+for name in ("h4", "h5"):
+    s = run(name)
+    study = run(f"{name}-study")
+    if s:
+        worst = max(st["capstans"]["capstan"]["max_penetration"] for st in s["steps"])
+        ratio = max(st["capstans"]["capstan"]["friction"]["max_traction_ratio"] for st in s["steps"])
+        T.check(worst < 1e-3, f"{name}: max_penetration {worst:.2e} < 1e-3 at every step")
+        T.check(ratio <= 1 + 1e-8, f"{name}: |t_f| / (mu t_n) <= {ratio:.12f} (<= 1 + 1e-8)")
+    if study:
+        pen = max(st["capstans"]["capstan"]["max_penetration"] for st in study["steps"])
+        print(f"    {name}-study: the study's loosened penalty lets the capstan in by {pen:.4f} "
+              f"({100 * pen / 0.175:.0f}% of the 0.175 indentation)")
+T.finish()
