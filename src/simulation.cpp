@@ -729,9 +729,12 @@ int Run::execute() {
       const auto mSaved = saveState();
       std::string why;
       if (solveAt(tDone, tEnd, rec, why)) {
-        // History (friction) moves on to this converged state.
-        for (const auto& e : assembly_->effects()) e->commit(assembly_->positions());
         tDone = tEnd;
+        // History (friction) moves on to this converged state; the step's
+        // last sub-step commits after the step's figures are taken, which
+        // belong to the increment that just converged.
+        if (tDone < rec.time - 1e-12 * dt)
+          for (const auto& e : assembly_->effects()) e->commit(assembly_->positions());
         h = std::min(2 * h, rec.time - tDone);
         continue;
       }
@@ -753,7 +756,6 @@ int Run::execute() {
       }
     }
     if (!ok) break;
-    assembly_->evaluate(*u_, nullptr, nullptr);
     {
       Vector f(u_->getMap());
       assembly_->evaluate(*u_, &f, nullptr);  // reactions at the converged state
@@ -762,6 +764,7 @@ int Run::execute() {
     rec.wall = since(tStep);
     steps_.push_back(rec);
     writeFields(step, rec.time);
+    for (const auto& e : assembly_->effects()) e->commit(assembly_->positions());
     writeHistory();
     if (!opt_.quiet && rank0_) {
       std::printf("step %d/%d  t=%.4g  newton=%d  linear=%d  |R|=%.3e  dV=%.1e  max_penetration=%.3e  %.2fs\n",

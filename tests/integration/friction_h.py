@@ -3,7 +3,9 @@
 inputs/seed/h1.xml ... h5.xml).
 
   * every scene converges and conforms; effects are brick, the foundation, contact and
-    friction (each capstan's friction is its own effect);
+    friction (each capstan's friction is its own effect); every step of every run is in
+    equilibrium: the capstan's force equals the sum of the supports' forces (1e-8 of
+    the largest);
   * H1 full-slip balance at every step: the capstan's x force equals the foundation's
     reaction (1e-8 relative), and the integral of the friction traction equals mu times
     the integral of the normal traction (1e-6: friction fully mobilised), every contact
@@ -36,6 +38,13 @@ def run(name, sets=(), tag=None):
         return None
     T.conforms(out, scene)
     T.check(not has_nan(s), f"{tag or name}: no NaN in summary.json")
+    worst = 0.0
+    for st in s["steps"]:
+        cap = st["capstans"]["capstan"]["force"]
+        sup = [sum(f["force"][i] for f in st["supports"].values()) for i in range(3)]
+        scale = max(max(abs(x) for x in cap), max(abs(x) for f in st["supports"].values() for x in f["force"]))
+        worst = max(worst, max(abs(a - b) for a, b in zip(cap, sup)) / scale)
+    T.check(worst <= 1e-8, f"{tag or name}: capstan force = sum of support forces at every step (worst rel. {worst:.1e})")
     c = s["steps"][-1]["capstans"]["capstan"]
     print(f"    {tag or name:14s} force = [{c['force'][0]:.8f}, {c['force'][1]:.8f}]  "
           f"xmin u_x = {s['final']['node_displacement_mean']['xmin'][0]:.8f}  "
