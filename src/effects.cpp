@@ -402,6 +402,7 @@ FrictionEffect::FrictionEffect(const std::string& name, const Mesh& mesh,
   const size_t nf = quads.size() / 4;
   loadEntities(mesh, quads, "friction", nodes_, X_);
   history_ = Kokkos::View<double*>("friction history", nf * kHistoryPerFace);
+  tangentialMultipliers_ = Kokkos::View<double*>("friction lambda_T", nf * kernels::kMaxFacePoints * 3);
   points_ = decltype(points_)("friction points", nf, kernels::kMaxFacePoints);
   local_.dofs = dofsOf(nodes_);
   local_.R = Matrix("friction R", nf, 12);
@@ -438,6 +439,8 @@ void FrictionEffect::launch(const NodalVectors& x, const NodalVectors&, bool tan
   auto active = local_.active;
   auto lambda = contact_.normalMultipliers();
   auto h = history_;
+  auto lambdaT = tangentialMultipliers_;
+  const bool useMultipliers = augmented();
   auto pts = points_;
   const kernels::Cylinder cyl = contact_.cylinder();
   const double eps = contact_.solvePenalty(), kappa = contact_.compliance();
@@ -456,7 +459,8 @@ void FrictionEffect::launch(const NodalVectors& x, const NodalVectors&, bool tan
         kernels::FrictionPoint p[kernels::kMaxFacePoints];
         active(f) = kernels::frictionFaceResidualTangent(
             Xf, xf, xn, cyl, eps, kappa, &lambda(f * kernels::kMaxFacePoints), rule, fp,
-            &h(f * kHistoryPerFace + 12), &R(f, 0), tangent ? &K(f, 0, 0) : nullptr, p);
+            useMultipliers ? &lambdaT(f * kernels::kMaxFacePoints * 3) : &h(f * kHistoryPerFace + 12),
+            &R(f, 0), tangent ? &K(f, 0, 0) : nullptr, p);
         for (int q = 0; q < kernels::facePointCount(rule); ++q) {
           for (int i = 0; i < 3; ++i) pts(f, q, kTraction + i) = p[q].traction[i];
           pts(f, q, kNormal) = p[q].normal;
@@ -471,6 +475,7 @@ void FrictionEffect::launch(const NodalVectors& x, const NodalVectors&, bool tan
 void FrictionEffect::commit(const NodalVectors& x) {
   auto nodes = nodes_;
   auto h = history_;
+  auto lambdaT = tangentialMultipliers_;
   auto pts = points_;
   const int nq = kernels::facePointCount(kernels::FaceRule(contact_.rule()));
   Kokkos::parallel_for(
@@ -478,8 +483,47 @@ void FrictionEffect::commit(const NodalVectors& x) {
         for (int a = 0; a < 4; ++a)
           for (int i = 0; i < 3; ++i) h(f * kHistoryPerFace + 3 * a + i) = x(nodes(f, a), i);
         for (int q = 0; q < nq; ++q)
-          for (int i = 0; i < 3; ++i) h(f * kHistoryPerFace + 12 + 3 * q + i) = pts(f, q, kTraction + i);
+          for (int i = 0; i < 3; ++i) {
+            h(f * kHistoryPerFace + 12 + 3 * q + i) = pts(f, q, kTraction + i);
+            lambdaT((f * kernels::kMaxFacePoints + q) * 3 + i) = pts(f, q, kTraction + i);
+          }
       });
+}
+
+void FrictionEffect::multiplierMap(const Kokkos::View<double*>& next) const {
+  if (!augmented()) return;
+  auto pts = points_;
+  const int nq = kernels::facePointCount(kernels::FaceRule(contact_.rule()));
+  Kokkos::deep_copy(next, 0.0);
+  Kokkos::parallel_for(
+      "friction multiplier map", Kokkos::RangePolicy<ExecSpace>(0, pts.extent(0)), KOKKOS_LAMBDA(int f) {
+        for (int q = 0; q < nq; ++q)
+          for (int i = 0; i < 3; ++i) next((f * kernels::kMaxFacePoints + q) * 3 + i) = pts(f, q, kTraction + i);
+      });
+}
+
+double FrictionEffect::constraintViolation() const {
+  if (!augmented()) return 0;
+  auto pts = points_;
+  auto lambdaT = tangentialMultipliers_;
+  const int nq = kernels::facePointCount(kernels::FaceRule(contact_.rule()));
+  const double epsT = parameters_.tangentPenalty;
+  double v = 0;
+  Kokkos::parallel_reduce(
+      "friction violation", Kokkos::RangePolicy<ExecSpace>(0, pts.extent(0)),
+      KOKKOS_LAMBDA(int f, double& m) {
+        for (int q = 0; q < nq; ++q) {
+          double d2 = 0;
+          for (int i = 0; i < 3; ++i) {
+            const double d = pts(f, q, kTraction + i) - lambdaT((f * kernels::kMaxFacePoints + q) * 3 + i);
+            d2 += d * d;
+          }
+          const double d = epsT * kernels::sqrt(d2);
+          m = d > m ? d : m;
+        }
+      },
+      Kokkos::Max<double>(v));
+  return v;
 }
 
 FrictionEffect::Figures FrictionEffect::figures() const {

@@ -241,6 +241,23 @@ class FrictionEffect : public Effect {
   Kokkos::View<double*> history() override { return history_; }
   void commit(const NodalVectors& x) override;
 
+  // Coulomb with the augmented Lagrangian contact: a tangential multiplier per
+  // point replaces last step's traction in the trial traction and is updated
+  // to the traction after each converged solve (Uzawa), so sticking points
+  // stick exactly (no elastic slip of size eps_t t) whatever the tangential
+  // penalty. Violation: eps_t |t - lambda_T|, the slip of a sticking point.
+  bool augmented() const {
+    return settings_.law == kernels::FrictionLaw::Coulomb && contact_.settings().exact;
+  }
+  Kokkos::View<double*> multipliers() override {
+    return augmented() ? tangentialMultipliers_ : Kokkos::View<double*>();
+  }
+  void multiplierMap(const Kokkos::View<double*>& next) const override;
+  bool accelerated() const override { return false; }
+  double constraintViolation() const override;
+  double constraintTolerance() const override { return contact_.settings().tolerance; }
+  std::string constraintName() const override { return name() + " stick slip"; }
+
   struct Figures {
     std::array<double, 3> force{};  // friction of the body on the capstan
     double torque = 0;              // about the capstan's axis
@@ -264,6 +281,7 @@ class FrictionEffect : public Effect {
   // [face][0..11]: node positions at the last converged state; then
   // [face][12 + 3q + i]: Coulomb's traction at point q from that state.
   Kokkos::View<double*> history_;
+  Kokkos::View<double*> tangentialMultipliers_;  // [(face * kMaxFacePoints + q) * 3 + i]
   // Per face and point at the last evaluation: traction (3), t_n, slip, state, weight, e (3).
   Kokkos::View<double** [10], Kokkos::LayoutRight> points_;
   Settings settings_;

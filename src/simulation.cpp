@@ -177,7 +177,7 @@ void Run::predict(double t0, double t1, double bareResidual, StepRecord& rec) {
     trial.update(alpha, du, 1.0, z, 1.0);
     assembly_->applyConstraints(trial, t1);
     const bool valid = assembly_->evaluate(trial, &f, nullptr);
-    if (std::getenv("CAPSTAN_NEWTON_LOG") && rank0_) std::printf("    predictor alpha %g valid %d |R| %.3e bare %.3e\n", alpha, int(valid), f.norm2(), bareResidual);
+    if (std::getenv("CAPSTAN_NEWTON_LOG") && rank0_ && !opt_.quiet) std::printf("    predictor alpha %g valid %d |R| %.3e bare %.3e\n", alpha, int(valid), f.norm2(), bareResidual);
     if (!valid) continue;  // inverts an element
     if (f.norm2() < bareResidual) {
       u_->update(1.0, trial, 0.0);
