@@ -95,7 +95,9 @@ ParameterList validParameters() {
           "Auto | GMRES | CG | Direct (Belos GMRES, Belos CG, Amesos2 KLU2). Auto: Direct up to "
           "Direct Solver Max Dofs on one rank, GMRES otherwise");
   sol.set("Direct Solver Max Dofs", 5000, "Auto: largest problem solved directly");
-  sol.set("Preconditioner", std::string("ILU"), "ILU | Jacobi | None (Ifpack2: additive Schwarz RILUK, relaxation)");
+  sol.set("Preconditioner", std::string("Auto"),
+          "Auto | ILU | Jacobi | MueLu | None (Ifpack2 RILUK per rank, Jacobi relaxation; MueLu smoothed "
+          "aggregation with the rigid-body modes). Auto: MueLu from 1000 dofs, ILU below");
   sol.set("ILU Level", 1, "ILU: level of fill (>= 0)");
   sol.set("Linear Tolerance", 1e-10, "Relative residual of each linear solve (0 < tol < 1)");
   sol.set("Max Linear Iterations", 2000, "Krylov iteration limit per linear solve");
@@ -429,7 +431,7 @@ Scene loadScene(const std::string& file, const std::vector<std::string>& sets,
     if (c.frictionLaw != "None" && sol.get<std::string>("Linear Solver") == "CG")
       v.fail("Solver/Linear Solver", "CG needs a symmetric matrix; friction on capstan '" + c.name +
                                          "' makes it non-symmetric (use Auto, GMRES or Direct)");
-  oneOf("Preconditioner", {"ILU", "Jacobi", "None"});
+  oneOf("Preconditioner", {"Auto", "ILU", "Jacobi", "MueLu", "None"});
   oneOf("Line Search", {"Backtrack", "Polynomial", "Full Step"});
   oneOf("Predictor", {"Tangent", "Previous"});
   for (const char* n : {"Linear Tolerance", "Newton Relative Tolerance", "Volume Tolerance"}) {
