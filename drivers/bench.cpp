@@ -1,24 +1,97 @@
-// capstan_bench: kernel throughput on one core.
+// capstan_bench: kernel and assembly throughput on one core, against the core's
+// measured floating-point peak (all figures from this one run, so their ratios
+// hold whatever the machine's load).
 //
 //   capstan_bench [cells-per-side]     (default 20: 8000 bricks)
 //
-// Prints brick residual+tangent and residual-only evaluations per second, and
-// the assembly (scatter into Tpetra) time per Newton iteration for the same box.
+// Prints a markdown table:
+//   - FMA peak: a loop of independent fused multiply-adds the compiler
+//     vectorises (2 flops each), GFLOP/s;
+//   - brick residual+tangent and residual only, contact face and friction face
+//     (Coulomb, sliding) kernels: evaluations/s, counted flops per evaluation,
+//     GFLOP/s and fraction of the FMA peak;
+//   - assembly: a plain global-index sumIntoGlobalValues loop (the element
+//     matrices already computed) against capstan's assembly (kernels, scatter
+//     at precomputed local offsets, export), elements/s.
 #include <Kokkos_Timer.hpp>
 #include <Tpetra_Core.hpp>
 
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
+#include <random>
+#include <vector>
 
 #include "assembly.hpp"
+#include "kernels/brick.hpp"
+#include "kernels/contact.hpp"
+#include "kernels/friction.hpp"
 
 using namespace capstan;
+
+namespace {
+
+// Repeats f (which does `work` units per call) for at least `seconds`; units/s.
+double rate(const std::function<void()>& f, double work, double seconds = 1.0) {
+  f();  // warm up
+  long reps = 0;
+  Kokkos::Timer t;
+  do {
+    f();
+    ++reps;
+  } while (t.seconds() < seconds);
+  return double(reps) * work / t.seconds();
+}
+
+// Peak: 12 independent accumulators of 8 doubles (one AVX-512 register each;
+// enough to cover the FMA latency on both pipes), each updated by a fused
+// multiply-add per iteration: flops/s = 2 x 96 x iterations / time.
+typedef double Vec8 __attribute__((vector_size(64)));
+__attribute__((noinline)) double fmaLoop(long iters, double m, double a) {
+  Vec8 acc[12];
+  for (int k = 0; k < 12; ++k)
+    for (int j = 0; j < 8; ++j) acc[k][j] = 1.0 + k + 0.1 * j;
+  const Vec8 vm = m - (Vec8){}, va = a - (Vec8){};
+  for (long it = 0; it < iters; ++it)
+#pragma GCC unroll 12
+    for (int k = 0; k < 12; ++k) acc[k] = acc[k] * vm + va;
+  double s = 0;
+  for (int k = 0; k < 12; ++k)
+    for (int j = 0; j < 8; ++j) s += acc[k][j];
+  return s;
+}
+
+double fmaPeak() {
+  const long iters = 10000000;
+  double sink = 0;
+  const double r = rate([&] { sink += fmaLoop(iters, 0.999999999, 1e-9); }, 2.0 * 96 * iters, 1.5);
+  if (sink == 42.0) std::printf("(unlikely)\n");  // keeps the loop alive
+  return r;
+}
+
+// Flops of brickResidualTangent counted from its loops (kernels/brick.hpp):
+//   pass 1, per Gauss point: reference gradients 434 (shape functions 120,
+//   dX/dxi 144, inverse 50, D 120), F 144, det 14, volume 2  -> 594
+//   pass 2, per Gauss point: inverse 50, d and G 240, R and g 168  -> 458
+//     tangent: H, e 96; per node pair D_a.D_b 5 + 1, 9 entries x 4 + 3 -> 64 x 45
+//   g g^T / (eps V): 576 x 3.
+constexpr double kBrickFlopsResidual = 8 * 594 + 8 * 458;
+constexpr double kBrickFlopsTangent = kBrickFlopsResidual + 8 * (96 + 64 * 45) + 576 * 3;
+// Contact face, 2x2 Gauss, every point in contact (kernels/contact.hpp), per point:
+//   area elements 2 x 60, shape 30, position 24, gap 30, traction 10,
+//   residual 12 x 4, C 3x3 30, tangent 16 node pairs x 9 x 4  -> ~870
+constexpr double kContactFlops = 4 * 870;
+
+}  // namespace
 
 int main(int argc, char** argv) {
   Tpetra::ScopeGuard scope(&argc, &argv);
   const int n = argc > 1 ? std::atoi(argv[1]) : 20;
   auto comm = Tpetra::getDefaultComm();
+  const double peak = fmaPeak();
+
+  // ---- brick kernel on a deformed box
   Scene scene;
   scene.mesh = {"Box", {0, 0, 0}, {1, 1, 1}, {n, n, n}};
   scene.solver = validParameters().sublist("Solver");
@@ -26,7 +99,6 @@ int main(int argc, char** argv) {
   BoxGenerator gen(scene.mesh.min, scene.mesh.max, scene.mesh.cells);
   Mesh mesh = distributeMesh(gen, comm);
   Assembly assembly(mesh, scene);
-  // A smooth non-trivial deformation.
   Vector u(mesh.ownedDofMap);
   {
     auto d = u.getDataNonConst();
@@ -41,33 +113,88 @@ int main(int argc, char** argv) {
   auto& bricks = assembly.bricks();
   const auto& x = assembly.positions();
   const auto& ux = assembly.displacements();
-  const long ne = long(mesh.numElements());
-  auto run = [&](bool tangent) {
-    int reps = 0;
-    Kokkos::Timer t;
-    do {
-      bricks.evaluate(x, ux, tangent);
-      ++reps;
-    } while (t.seconds() < 2.0);
-    return double(reps) * double(ne) / t.seconds();
-  };
-  const double withTangent = run(true), residualOnly = run(false);
+  const double ne = double(mesh.numElements());
+  const double brickTangent = rate([&] { bricks.evaluate(x, ux, true); }, ne);
+  const double brickResidual = rate([&] { bricks.evaluate(x, ux, false); }, ne);
+
+  // ---- face kernels on one face pressed into a capstan, every point in contact
+  const double Xf[4][3] = {{0, 1, 0}, {0.5, 1, 0}, {0.5, 1, 0.5}, {0, 1, 0.5}};
+  double xf[4][3], xn[4][3];
+  for (int a = 0; a < 4; ++a)
+    for (int i = 0; i < 3; ++i) xf[a][i] = xn[a][i] = Xf[a][i] + (i == 1 ? -0.01 * a : 0.0);
+  for (int a = 0; a < 4; ++a) xn[a][0] -= 0.02;  // the face moved 0.02 along x in the step
+  kernels::Cylinder cyl{{0.25, 2.95, 0}, {0, 0, 1}, 2.0};
+  const double lambda[kernels::kMaxFacePoints] = {};
+  double R[12], K[144];
+  kernels::ContactPoint cp[kernels::kMaxFacePoints];
+  const int faces = 10000;
+  double sink = 0;
+  const double contact = rate(
+      [&] {
+        for (int f = 0; f < faces; ++f) {
+          cyl.a[1] = 2.95 + 1e-9 * (f & 7);  // keeps the call from being hoisted
+          kernels::contactFaceResidualTangent(Xf, xf, cyl, 1e-3, 1e-3, lambda, kernels::FaceRule::Gauss2, R, K, cp);
+          sink += K[13];
+        }
+      },
+      faces);
+  kernels::FrictionParameters fp;
+  fp.law = kernels::FrictionLaw::Coulomb;
+  fp.mu = 0.5;
+  fp.tangentPenalty = 1e-3;
+  fp.spin = 0.1;
+  const double history[3 * kernels::kMaxFacePoints] = {};
+  kernels::FrictionPoint fpts[kernels::kMaxFacePoints];
+  const double friction = rate(
+      [&] {
+        for (int f = 0; f < faces; ++f) {
+          cyl.a[1] = 2.95 + 1e-9 * (f & 7);
+          kernels::frictionFaceResidualTangent(Xf, xf, xn, cyl, 1e-3, 1e-3, lambda, kernels::FaceRule::Gauss2, fp,
+                                               history, R, K, fpts);
+          sink += K[13];
+        }
+      },
+      faces);
+
+  // ---- assembly: plain global-index insertion vs capstan's
   auto W = assembly.createMatrix();
   Vector f(mesh.ownedDofMap);
-  const double before = assembly.assemblySeconds();
-  int reps = 0;
-  Kokkos::Timer t;
-  do {
-    assembly.evaluate(u, &f, W.get());
-    ++reps;
-  } while (t.seconds() < 2.0);
-  const double perAssembly = (assembly.assemblySeconds() - before) / reps;
+  assembly.evaluate(u, &f, W.get());
+  const auto& L = bricks.local();
+  auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.dofs);
+  auto Kh = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.K);
+  const auto& overlap = *mesh.overlapDofMap;
+  std::vector<GO> gids(24);
+  const double plainGlobal = rate(
+      [&] {
+        W->beginAssembly();
+        W->setAllToScalar(0.0);
+        for (size_t e = 0; e < dofs.extent(0); ++e) {
+          for (int k = 0; k < 24; ++k) gids[k] = overlap.getGlobalElement(dofs(e, k));
+          for (int k = 0; k < 24; ++k)
+            W->sumIntoGlobalValues(gids[k], Teuchos::ArrayView<const GO>(gids),
+                                   Teuchos::ArrayView<const double>(&Kh(e, k, 0), 24));
+        }
+        W->endAssembly();
+      },
+      ne);
+  const double ours = rate([&] { assembly.evaluate(u, &f, W.get()); }, ne);
+
   if (comm->getRank() == 0) {
-    std::printf("bricks: %ld on this rank (%d^3 box)\n", ne, n);
-    std::printf("brick residual+tangent: %.3e evaluations/s\n", withTangent);
-    std::printf("brick residual only:    %.3e evaluations/s\n", residualOnly);
-    std::printf("full assembly (kernels + scatter + export, residual and tangent): %.4f s\n", perAssembly);
-    std::printf("  of which brick kernel: %.4f s\n", double(ne) / withTangent);
+    auto row = [&](const char* what, double evals, double flops) {
+      std::printf("| %s | %.3e | %.0f | %.2f | %.1f%% |\n", what, evals, flops, evals * flops * 1e-9,
+                  100 * evals * flops / peak);
+    };
+    std::printf("bricks: %.0f on this rank (%d^3 box); FMA peak of this core: %.1f GFLOP/s\n\n", ne, n, peak * 1e-9);
+    std::printf("| kernel | evaluations/s | flops/evaluation | GFLOP/s | of peak |\n|---|---|---|---|---|\n");
+    row("brick residual + tangent", brickTangent, kBrickFlopsTangent);
+    row("brick residual only", brickResidual, kBrickFlopsResidual);
+    row("contact face, 2x2 Gauss, in contact", contact, kContactFlops);
+    std::printf("| friction face, Coulomb sliding, 2x2 Gauss | %.3e | | | |\n\n", friction);
+    std::printf("| assembly of residual + tangent | elements/s | ratio |\n|---|---|---|\n");
+    std::printf("| plain sumIntoGlobalValues loop (insertion only) | %.3e | 1 |\n", plainGlobal);
+    std::printf("| capstan (kernels + local scatter + export) | %.3e | %.1f |\n", ours, ours / plainGlobal);
+    if (sink == 42.0) std::printf("(unlikely)\n");
   }
   return 0;
 }

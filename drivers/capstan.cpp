@@ -15,13 +15,21 @@
 namespace {
 
 const char* kUsage =
-    "usage: capstan run SCENE.xml [--output DIR] [--set PATH=VALUE]... [--quiet]\n"
+    "usage: capstan run SCENE.xml [--output DIR] [--set PATH=VALUE]... [--restart DIR] [--quiet]\n"
     "       capstan validate SCENE.xml [--set PATH=VALUE]...\n"
     "       capstan params\n"
-    "       capstan --version\n";
+    "       capstan --version\n"
+    "\n"
+    "  --output DIR      write the outputs to DIR (overrides Output/Directory)\n"
+    "  --set PATH=VALUE  override one scene parameter, e.g. --set \"Mesh/Cells={28,8,12}\"\n"
+    "  --restart DIR     continue from the last checkpoint in DIR, the output directory of an\n"
+    "                    earlier run of the scene with Output/Checkpoint Every > 0 (same mesh,\n"
+    "                    step size and number of ranks); outputs list every step\n"
+    "  --quiet           no progress lines\n"
+    "exit status: 0 converged, 1 bad input (nothing written), 2 did not converge\n";
 
 struct Args {
-  std::string command, scene, output;
+  std::string command, scene, output, restart;
   std::vector<std::string> sets;
   bool quiet = false;
 };
@@ -44,6 +52,8 @@ bool parse(int argc, char** argv, Args& a, std::string& error) {
       else if (s == "--set") a.sets.push_back(value("--set"));
       else if (s.rfind("--set=", 0) == 0) a.sets.push_back(s.substr(6));
       else if (s.rfind("--output=", 0) == 0) a.output = s.substr(9);
+      else if (s == "--restart") a.restart = value("--restart");
+      else if (s.rfind("--restart=", 0) == 0) a.restart = s.substr(10);
       else if (s == "--quiet") a.quiet = true;
       else if (!s.empty() && s[0] == '-') throw std::runtime_error("unknown option " + s);
       else if (a.scene.empty()) a.scene = s;
@@ -89,13 +99,19 @@ int main(int argc, char** argv) {
     if (rank0) std::cerr << "capstan: " << args.command << " needs a scene file\n" << kUsage;
     return 1;
   }
+  if (!args.restart.empty() && args.command != "run") {
+    if (rank0) std::cerr << "capstan: --restart applies to run only\n" << kUsage;
+    return 1;
+  }
   try {
     const auto scene = capstan::loadScene(args.scene, args.sets, args.output);
+    if (rank0)
+      for (const auto& w : scene.warnings) std::cerr << "capstan: WARNING: " << w << "\n";
     if (args.command == "validate") {
       if (rank0) Teuchos::writeParameterListToXmlOStream(scene.resolved, std::cout);
       return 0;
     }
-    return capstan::runScene(scene, comm, {args.quiet});
+    return capstan::runScene(scene, comm, {args.quiet, args.restart});
   } catch (const capstan::InputError& e) {
     if (rank0) std::cerr << "capstan: error: " << e.what() << "\n";
     return 1;

@@ -50,27 +50,42 @@ KOKKOS_INLINE_FUNCTION double brickVolume(const double X[8][3], const double x[8
 
 // Residual R[24] (dof 3a+i) and, if K is not null, the tangent K[24*24]
 // (row-major) of one brick. V: reference volume.
+//
+// Two passes over the 8 Gauss points: the first computes F and the volume v
+// (the pressure p(v) enters every term of the second), keeping the reference
+// gradients and F so that the second pass does not recompute them. The
+// tangent's inner loop uses per-node vectors scaled once per Gauss point, so
+// each of the 576 entries costs 2 multiply-adds (plus the diagonal):
+//   K[ai][bk] += H_a,i d_b,k + d_b,i e_a,k + delta_ik s_ab,
+//   H_a = wJ (2c G_a - q d_a),  e_a = wJ q d_a,  s_ab = wJ 2c D_a.D_b.
+// (A component-major variant with 8-wide inner loops measured 30% slower.)
 KOKKOS_INLINE_FUNCTION void brickResidualTangent(const double X[8][3], const double x[8][3],
                                                  double V, double pbar, double c, double eps,
                                                  double* R, double* K, BrickState& out) {
   const bool wantTangent = K != nullptr;
-  out.volume = brickVolume(X, x, out.minJ);
-  const double p = pbar - (out.volume - V) / (eps * V);
+  double Dq[8][8][3], Fq[8][3][3], wq[8];
+  double v = 0, minJ = 1e300;
+  for (int gp = 0; gp < 8; ++gp) {
+    wq[gp] = hexReferenceGradients(X, gauss2(gp & 1), gauss2((gp >> 1) & 1), gauss2(gp >> 2), Dq[gp]);
+    deformationGradient(x, Dq[gp], Fq[gp]);
+    const double J = det3(Fq[gp]);
+    minJ = J < minJ ? J : minJ;
+    v += J * wq[gp];
+  }
+  out.volume = v;
+  out.minJ = minJ;
+  const double p = pbar - (v - V) / (eps * V);
   out.pressure = p;
   const double q = p + 2 * c;  // sigma = -q I + 2c B
   double g[24];
   for (int r = 0; r < 24; ++r) R[r] = g[r] = 0;
   if (wantTangent)
     for (int r = 0; r < 576; ++r) K[r] = 0;
-
   for (int gp = 0; gp < 8; ++gp) {
-    double D[8][3];
-    const double w = hexReferenceGradients(X, gauss2(gp & 1), gauss2((gp >> 1) & 1),
-                                           gauss2(gp >> 2), D);
-    double F[3][3], Finv[3][3];
-    deformationGradient(x, D, F);
-    const double J = inverse3(F, Finv);
-    const double wJ = w * J;
+    const double(*D)[3] = Dq[gp];
+    const double(*F)[3] = Fq[gp];
+    double Finv[3][3];
+    const double wJ = wq[gp] * inverse3(Fq[gp], Finv);
     double d[8][3], G[8][3];  // spatial gradients F^{-T} D_a and push-forward F D_a
     for (int a = 0; a < 8; ++a)
       for (int i = 0; i < 3; ++i) {
@@ -84,15 +99,21 @@ KOKKOS_INLINE_FUNCTION void brickResidualTangent(const double X[8][3], const dou
       }
     if (!wantTangent) continue;
     // dP/dF contracted with D_a, D_b (P = 2cJ F - qJ F^{-T}, q at fixed p):
-    //   J [2c (G_a,i d_b,k + delta_ik D_a.D_b) - q (d_a,i d_b,k - d_a,k d_b,i)]
+    //   wJ [2c (G_a,i d_b,k + delta_ik D_a.D_b) - q (d_a,i d_b,k - d_a,k d_b,i)]
+    const double c2 = 2 * c * wJ, qw = q * wJ;
+    double H[8][3], e[8][3];
+    for (int a = 0; a < 8; ++a)
+      for (int i = 0; i < 3; ++i) {
+        H[a][i] = c2 * G[a][i] - qw * d[a][i];
+        e[a][i] = qw * d[a][i];
+      }
     for (int a = 0; a < 8; ++a)
       for (int b = 0; b < 8; ++b) {
-        const double DaDb = D[a][0] * D[b][0] + D[a][1] * D[b][1] + D[a][2] * D[b][2];
+        const double s = c2 * (D[a][0] * D[b][0] + D[a][1] * D[b][1] + D[a][2] * D[b][2]);
         for (int i = 0; i < 3; ++i) {
           double* row = K + (3 * a + i) * 24 + 3 * b;
-          for (int k = 0; k < 3; ++k)
-            row[k] += wJ * (2 * c * (G[a][i] * d[b][k] + (i == k ? DaDb : 0.0)) -
-                            q * (d[a][i] * d[b][k] - d[a][k] * d[b][i]));
+          for (int k = 0; k < 3; ++k) row[k] += H[a][i] * d[b][k] + d[b][i] * e[a][k];
+          row[i] += s;
         }
       }
   }
@@ -102,6 +123,7 @@ KOKKOS_INLINE_FUNCTION void brickResidualTangent(const double X[8][3], const dou
     for (int r = 0; r < 24; ++r)
       for (int t = 0; t < 24; ++t) K[r * 24 + t] += s * g[r] * g[t];
 }
+
 
 // Cauchy stress at the centroid, Voigt order xx yy zz xy yz xz.
 KOKKOS_INLINE_FUNCTION void brickCentroidStress(const double X[8][3], const double x[8][3],

@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """What accuracy costs in time: sweep knobs of a base scene, run capstan for every
 value, and report each quantity of interest's error against the sweep's reference
 together with the run's wall time.
@@ -59,6 +59,8 @@ QUANTITIES = {
     "max_penetration": lambda s: _capstan(s, "max_penetration"),
     "stick_points": lambda s: _capstan(s, "stick_points"),
     "slip_points": lambda s: _capstan(s, "slip_points"),
+    "max_ux": lambda s: s["final"]["max_displacement"][0],
+    "max_uy": lambda s: s["final"]["max_displacement"][1],
     "ymax_mean_uy": lambda s: s["final"]["node_displacement_mean"].get("ymax", [None, None])[1],
     "xmin_mean_ux": lambda s: s["final"]["node_displacement_mean"].get("xmin", [None])[0],
 }
@@ -128,13 +130,26 @@ def run(args, tag, sets):
         return json.load(f)
 
 
-def richardson(q, r):
-    """Extrapolated value and observed order from three values on meshes refined by r."""
+def richardson(q, f):
+    """Extrapolated value and observed order p from three values q on meshes refined by
+    the factors f (h ~ 1/f): q_i = q* + C f_i^-p. None for p if the differences change sign."""
     d1, d2 = q[1] - q[0], q[2] - q[1]
     if d1 == 0 or d2 == 0 or d1 * d2 < 0:
         return q[2], None
-    p = math.log(abs(d1 / d2)) / math.log(r)
-    return q[2] + d2 / (r ** p - 1), p
+    h = [1.0 / x for x in f]
+    ratio = abs(d1 / d2)
+
+    def g(p):  # (h0^p - h1^p) / (h1^p - h2^p) - ratio, increasing in p
+        return (h[0] ** p - h[1] ** p) / (h[1] ** p - h[2] ** p) - ratio
+
+    lo, hi = 1e-3, 20.0
+    if g(lo) > 0 or g(hi) < 0:
+        return q[2], None
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if g(mid) < 0 else (lo, mid)
+    p = 0.5 * (lo + hi)
+    return q[2] + d2 * h[2] ** p / (h[1] ** p - h[2] ** p), p
 
 
 def main():
@@ -148,9 +163,15 @@ def main():
     ap.add_argument("--capstan", default=os.path.join(os.path.dirname(__file__), "..", "build", "capstan"))
     ap.add_argument("--ranks", type=int, default=1)
     ap.add_argument("--no-plot", action="store_true")
+    ap.add_argument("--columns", default="",
+                    help="comma-separated quantities for study.md and study.png (default: all that apply)")
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)
     base = scene_values(args.scene, args.set)
+    shown = [c for c in args.columns.split(",") if c]
+    for c in shown:
+        if c not in QUANTITIES:
+            sys.exit(f"study: unknown quantity '{c}' (known: {', '.join(QUANTITIES)})")
 
     rows, report = [], ["# Study of " + args.scene, ""]
     reference_run = run(args, "reference", args.reference_set) if args.reference_set else None
@@ -163,14 +184,17 @@ def main():
         ref, order = {}, {}
         for qn, fn in QUANTITIES.items():
             qs = [fn(s) if s["converged"] else None for s in runs]
-            if qs[-1] is None:
+            if qn in ABSOLUTE:
+                ref[qn] = 0.0
+            elif reference_run is not None and knob != "mesh":
+                ref[qn] = fn(reference_run) if reference_run["converged"] else None
+            else:  # the most accurate run that converged
+                ref[qn] = next((q for q in reversed(qs) if q is not None), None)
+            if ref[qn] is None:
+                del ref[qn]
                 continue
-            ref[qn] = 0.0 if qn in ABSOLUTE else qs[-1]
-            if reference_run is not None and knob != "mesh" and qn not in ABSOLUTE:
-                ref[qn] = fn(reference_run)
             if knob == "mesh" and len(qs) >= 3 and None not in qs[-3:] and qn not in ABSOLUTE:
-                ratio = int(values[-1]) / int(values[-2])
-                ref[qn], order[qn] = richardson(qs[-3:], ratio)
+                ref[qn], order[qn] = richardson(qs[-3:], [float(x) for x in values[-3:]])
         report += [f"## Sweep `{knob}` over {', '.join(values)}", "",
                    "reference: " + ("Richardson extrapolation of the three finest meshes" if order
                                     else "the finest mesh" if knob == "mesh"
@@ -179,7 +203,7 @@ def main():
         if order:
             report += ["observed order of convergence: " +
                        ", ".join(f"{q} {p:.2f}" for q, p in order.items() if p is not None), ""]
-        cols = [q for q in QUANTITIES if q in ref]
+        cols = [q for q in QUANTITIES if q in ref and (not shown or q in shown)]
         report += ["| value | wall s | converged | " + " | ".join(f"{q} (error)" for q in cols) + " |",
                    "|---|---|---|" + "---|" * len(cols)]
         for v, s in zip(values, runs):
@@ -208,14 +232,14 @@ def main():
         f.write("\n".join(report) + "\n")
     print("\n".join(report))
     if not args.no_plot:
-        plot(rows, os.path.join(args.out, "study.png"), args.scene)
+        plot(rows, os.path.join(args.out, "study.png"), args.scene, shown)
 
 
-def plot(rows, path, title):
+def plot(rows, path, title, shown=()):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    qs = [q for q in QUANTITIES if any((r.get(q + "_error") or 0) > 0 for r in rows)]
+    qs = [q for q in QUANTITIES if any((r.get(q + "_error") or 0) > 0 for r in rows) and (not shown or q in shown)]
     if not qs:
         return
     n = len(qs)

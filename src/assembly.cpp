@@ -46,6 +46,9 @@ Assembly::Assembly(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
       }
   }
 
+  if (scene.bodyForce != std::array<double, 3>{0, 0, 0})
+    effects_.push_back(std::make_unique<BodyForceEffect>(mesh, scene.bodyForce, scene.steps * scene.stepSize));
+
   for (const auto& c : scene.capstans) {
     ContactEffect::Settings set;
     set.radius = c.radius;
@@ -105,6 +108,7 @@ Assembly::Assembly(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
   graph_->beginAssembly();
   const auto& overlap = *mesh.overlapDofMap;
   for (const auto& effect : effects_) {
+    if (effect->local().K.extent(0) == 0) continue;  // no stiffness, no graph entries
     auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), effect->local().dofs);
     std::vector<GO> cols(dofs.extent(1));
     for (size_t e = 0; e < dofs.extent(0); ++e) {
@@ -116,6 +120,10 @@ Assembly::Assembly(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
   // Each effect's dofs as local column ids of the assembled matrix.
   const auto& colMap = *graph_->getColMap();
   for (const auto& effect : effects_) {
+    if (effect->local().K.extent(0) == 0) {
+      columns_.emplace_back();
+      continue;
+    }
     auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), effect->local().dofs);
     std::vector<LO> cols(dofs.size());
     for (size_t e = 0; e < dofs.extent(0); ++e)
@@ -123,10 +131,56 @@ Assembly::Assembly(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
         cols[e * dofs.extent(1) + k] = colMap.getLocalElement(overlap.getGlobalElement(dofs(e, k)));
     columns_.push_back(std::move(cols));
   }
+  findEntryOffsets();
   uOverlap_ = rcp(new Vector(mesh.overlapDofMap));
   residual_ = rcp(new Tpetra::FEMultiVector<>(mesh.ownedDofMap, importer_, 1));
   x_ = NodalVectors("x", mesh.numOverlapNodes());
   u_ = NodalVectors("u", mesh.numOverlapNodes());
+}
+
+void Assembly::findEntryOffsets() {
+  // The owned-plus-shared matrix is active between beginAssembly and endAssembly;
+  // its local rows are the overlapped dof ids the effects use.
+  auto W = createMatrix();
+  W->beginAssembly();
+  const auto local = W->getLocalMatrixHost();
+  const auto rowStart = local.graph.row_map;
+  const auto entries = local.graph.entries;
+  auto find = [&](LO row, LO col) -> long {
+    for (auto j = rowStart(row); j < rowStart(row + 1); ++j)
+      if (entries(j) == col) return long(j);
+    throw std::logic_error("assembly: an element entry is missing from the matrix graph");
+  };
+  const auto& supportOf = constraints_.supportOf;
+  for (size_t i = 0; i < effects_.size(); ++i) {
+    const auto& L = effects_[i]->local();
+    if (L.K.extent(0) == 0) {
+      entryOffsets_.emplace_back();
+      continue;
+    }
+    auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.dofs);
+    const size_t n = dofs.extent(1);
+    Kokkos::View<long***, Kokkos::LayoutRight> offsets("entry offsets", dofs.extent(0), n, n);
+    auto h = Kokkos::create_mirror_view(offsets);
+    for (size_t e = 0; e < dofs.extent(0); ++e)
+      for (size_t k = 0; k < n; ++k)
+        for (size_t l = 0; l < n; ++l)
+          h(e, k, l) = supportOf[dofs(e, k)] >= 0 || supportOf[dofs(e, l)] >= 0
+                           ? -1
+                           : find(dofs(e, k), columns_[i][e * n + l]);
+    Kokkos::deep_copy(offsets, h);
+    entryOffsets_.push_back(offsets);
+  }
+  const auto& colMap = *W->getColMap();
+  const auto& overlap = *mesh_.overlapDofMap;
+  std::vector<long> diagonal;
+  for (LO d = 0; d < LO(3 * mesh_.numOwnedNodes); ++d)
+    if (supportOf[d] >= 0) diagonal.push_back(find(d, colMap.getLocalElement(overlap.getGlobalElement(d))));
+  constrainedDiagonal_ = Kokkos::View<long*>("constrained diagonal", diagonal.size());
+  auto hd = Kokkos::create_mirror_view(constrainedDiagonal_);
+  for (size_t j = 0; j < diagonal.size(); ++j) hd(j) = diagonal[j];
+  Kokkos::deep_copy(constrainedDiagonal_, hd);
+  W->endAssembly();
 }
 
 RCP<FEMatrix> Assembly::createMatrix() const { return rcp(new FEMatrix(graph_)); }
@@ -178,34 +232,33 @@ bool Assembly::evaluate(const Vector& u, Vector* f, FEMatrix* W) {
   }
 
   if (W) {
+    // Element matrices are added straight into the local CRS values at their
+    // precomputed offsets, in a parallel loop (atomic: entities share entries).
     W->beginAssembly();
     W->setAllToScalar(0.0);
-    auto& vals = rowValues_;  // kept between assemblies: no allocation per iteration
+    const auto values = W->getLocalMatrixDevice().values;
     for (size_t i = 0; i < effects_.size(); ++i) {
       const auto& L = effects_[i]->local();
-      auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.dofs);
-      auto K = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.K);
-      auto active = activeOnHost(L);
-      const size_t n = dofs.extent(1);
-      vals.resize(n);
-      for (size_t e = 0; e < dofs.extent(0); ++e) {
-        if (active.size() && !active(e)) continue;
-        const LO* cols = &columns_[i][e * n];
-        for (size_t k = 0; k < n; ++k) {
-          if (supportOf[dofs(e, k)] >= 0) continue;
-          for (size_t l = 0; l < n; ++l) vals[l] = supportOf[dofs(e, l)] >= 0 ? 0.0 : K(e, k, l);
-          W->sumIntoLocalValues(dofs(e, k), LO(n), vals.data(), cols);
-        }
-      }
+      if (L.K.extent(0) == 0) continue;
+      const auto K = L.K;
+      const auto active = L.active;
+      const auto offsets = entryOffsets_[i];
+      const int n = int(K.extent(1));
+      Kokkos::parallel_for(
+          "scatter", Kokkos::RangePolicy<ExecSpace>(0, K.extent(0)), KOKKOS_LAMBDA(int e) {
+            if (active.extent(0) && !active(e)) return;
+            for (int k = 0; k < n; ++k)
+              for (int l = 0; l < n; ++l) {
+                const long o = offsets(e, k, l);
+                if (o >= 0) Kokkos::atomic_add(&values(o), K(e, k, l));
+              }
+          });
     }
-    const double one = 1.0;
-    const auto& colMap = *W->getColMap();
-    const auto& overlap = *mesh_.overlapDofMap;
-    for (LO d = 0; d < LO(3 * mesh_.numOwnedNodes); ++d) {
-      if (supportOf[d] < 0) continue;
-      const LO col = colMap.getLocalElement(overlap.getGlobalElement(d));
-      W->sumIntoLocalValues(d, 1, &one, &col);
-    }
+    const auto diagonal = constrainedDiagonal_;
+    Kokkos::parallel_for(
+        "constrained diagonal", Kokkos::RangePolicy<ExecSpace>(0, diagonal.extent(0)),
+        KOKKOS_LAMBDA(int j) { values(diagonal(j)) = 1.0; });
+    Kokkos::fence();
     W->endAssembly();
   }
   assemblySeconds_ += timer.seconds();
@@ -240,10 +293,11 @@ void Assembly::tangentAction(const Vector& z, Vector& y) {
     Matrix out("K z", dofs.extent(0), dofs.extent(1));
     auto ho = Kokkos::create_mirror_view(out);
     auto active = activeOnHost(L);
+    const bool stiff = L.K.extent(0) > 0;
     for (size_t e = 0; e < dofs.extent(0); ++e)
       for (size_t k = 0; k < dofs.extent(1); ++k) {
         double s = 0;
-        if (active.size() && !active(e)) {
+        if (!stiff || (active.size() && !active(e))) {
           ho(e, k) = 0;
           continue;
         }

@@ -85,6 +85,7 @@ class Assembly {
 
  private:
   void sumEntityVectors(const std::vector<Matrix>& values);  // into residual_ (owned)
+  void findEntryOffsets();
 
   const Mesh& mesh_;
   std::vector<std::unique_ptr<Effect>> effects_;
@@ -98,11 +99,15 @@ class Assembly {
   Constraints constraints_;
   RCP<FEGraph> graph_;
   std::vector<std::vector<LO>> columns_;  // per effect: [entity * dofs + k] matrix column ids
+  // Per effect: where each element-matrix entry (entity, k, l) lands in the
+  // values of the local (owned plus shared) CRS matrix, -1 for entries of
+  // constrained rows or columns. Found once, so assembly is a plain scatter.
+  std::vector<Kokkos::View<long***, Kokkos::LayoutRight>> entryOffsets_;
+  Kokkos::View<long*> constrainedDiagonal_;  // offsets of the owned constrained diagonals
   RCP<const Tpetra::Import<>> importer_;
   RCP<Vector> uOverlap_;
   RCP<Tpetra::FEMultiVector<>> residual_;
   std::vector<double> rawOwnedResidual_;
-  std::vector<double> rowValues_;
   NodalVectors x_, u_;
   double assemblySeconds_ = 0;
 };

@@ -6,6 +6,7 @@
 
 #include <cmath>
 
+#include "../kernels/body_force.hpp"
 #include "../kernels/brick.hpp"
 #include "../kernels/contact.hpp"
 #include "../kernels/foundation.hpp"
@@ -193,6 +194,29 @@ std::array<double, 3> FoundationEffect::localForceOnBody() const {
     for (int a = 0; a < 4; ++a)
       for (int i = 0; i < 3; ++i) F[i] -= R(f, 3 * a + i);  // R = internal - external
   return F;
+}
+
+// ---------------------------------------------------------------- body force
+
+BodyForceEffect::BodyForceEffect(const Mesh& mesh, std::array<double, 3> b, double endTime)
+    : Effect("body force"), b_(b), endTime_(endTime) {
+  loadEntities(mesh, mesh.connectivity, "body force", nodes_, X_);
+  local_.dofs = dofsOf(nodes_);
+  local_.R = Matrix("body force R", nodes_.extent(0), 24);
+}
+
+void BodyForceEffect::launch(const NodalVectors&, const NodalVectors&, bool) {
+  auto X = X_;
+  auto R = local_.R;
+  const double b0 = scale_ * b_[0], b1 = scale_ * b_[1], b2 = scale_ * b_[2];
+  Kokkos::parallel_for(
+      "body force", Kokkos::RangePolicy<ExecSpace>(0, X.extent(0)), KOKKOS_LAMBDA(int e) {
+        double Xe[8][3];
+        for (int a = 0; a < 8; ++a)
+          for (int i = 0; i < 3; ++i) Xe[a][i] = X(e, a, i);
+        const double b[3] = {b0, b1, b2};
+        kernels::brickBodyForce(Xe, b, &R(e, 0));
+      });
 }
 
 // ---------------------------------------------------------------- contact

@@ -27,7 +27,7 @@ using NodalVectors = Kokkos::View<double* [3], Kokkos::LayoutRight>;
 struct LocalSystem {
   IntMatrix dofs;  // [entity][k]: overlapped dof ids (3 * node + component)
   Matrix R;        // [entity][k]
-  Tensor3 K;       // [entity][k][l]
+  Tensor3 K;       // [entity][k][l]; empty for effects without stiffness (dead loads)
   // Optional: entities with active(e) == 0 contribute nothing this evaluation
   // (contact faces away from the capstan); empty = all active. The matrix
   // graph still holds them, so the sparsity pattern never changes.
@@ -132,6 +132,23 @@ class FoundationEffect : public Effect {
   Kokkos::View<double* [4][3], Kokkos::LayoutRight> X_;
   double k_;
   int mask_[3];
+};
+
+// Dead body force b per unit reference volume on every brick (Loads/Body Force),
+// ramped with time: b t / endTime. No stiffness (local().K is empty).
+class BodyForceEffect : public Effect {
+ public:
+  BodyForceEffect(const Mesh& mesh, std::array<double, 3> b, double endTime);
+  void setInterval(double, double tEnd) override { scale_ = tEnd / endTime_; }
+
+ protected:
+  void launch(const NodalVectors& x, const NodalVectors& u, bool tangent) override;
+
+ private:
+  Kokkos::View<int* [8], Kokkos::LayoutRight> nodes_;
+  Kokkos::View<double* [8][3], Kokkos::LayoutRight> X_;
+  std::array<double, 3> b_;
+  double endTime_, scale_ = 0;
 };
 
 // Normal contact of candidate faces with one rigid capstan (kernels/contact.hpp).

@@ -137,49 +137,121 @@ struct FieldWriter::Impl {
     check(g >= 0, "cannot create group " + path);
   }
 
+  // Layout checks shared by both constructors (collective).
+  void init(const std::string& directory, const FieldLayout& layout);
+
+  // Names of the links in group `path`, in name order.
+  std::vector<std::string> children(const std::string& path) const {
+    std::vector<std::string> names;
+    H5G_info_t info;
+    check(H5Gget_info_by_name(file, path.c_str(), &info, H5P_DEFAULT) >= 0, "cannot read group " + path);
+    for (hsize_t i = 0; i < info.nlinks; ++i) {
+      const ssize_t n = H5Lget_name_by_idx(file, path.c_str(), H5_INDEX_NAME, H5_ITER_INC, i, nullptr, 0,
+                                           H5P_DEFAULT);
+      check(n >= 0, "cannot list group " + path);
+      std::string name(size_t(n) + 1, '\0');
+      H5Lget_name_by_idx(file, path.c_str(), H5_INDEX_NAME, H5_ITER_INC, i, &name[0], name.size(),
+                         H5P_DEFAULT);
+      name.resize(size_t(n));
+      names.push_back(name);
+    }
+    return names;
+  }
+
+  // The fields of a written step's group (name, components), for the index.
+  void readShapes(const std::string& group, FieldShapes& shapes) const {
+    if (H5Lexists(file, group.c_str(), H5P_DEFAULT) <= 0) return;
+    for (const std::string& name : children(group)) {
+      const std::string path = group + "/" + name;
+      Handle dset(H5Dopen2(file, path.c_str(), H5P_DEFAULT), H5Dclose);
+      check(dset >= 0, "cannot open dataset " + path);
+      Handle space(H5Dget_space(dset), H5Sclose);
+      hsize_t dims[2] = {0, 0};
+      check(space >= 0 && H5Sget_simple_extent_ndims(space) == 2 &&
+                H5Sget_simple_extent_dims(space, dims, nullptr) == 2,
+            "not a 2-D dataset: " + path);
+      shapes.emplace_back(name, int(dims[1]));
+    }
+  }
+
+  // Appends to `err` where this rank's rows of integer dataset `path` differ
+  // from `expected` (or the dataset's shape from [global, components]).
+  void compareRows(const std::string& path, long long offset, long long owned, long long global,
+                   int components, const std::vector<long long>& expected,
+                   std::ostringstream& err) const {
+    Handle dset(H5Lexists(file, path.c_str(), H5P_DEFAULT) > 0 ? H5Dopen2(file, path.c_str(), H5P_DEFAULT) : -1,
+                H5Dclose);
+    if (dset < 0) {
+      err << "FieldWriter: " << h5Path << ": no " << path << "; ";
+      return;
+    }
+    Handle space(H5Dget_space(dset), H5Sclose);
+    hsize_t dims[2] = {0, 0};
+    if (space < 0 || H5Sget_simple_extent_ndims(space) != 2 ||
+        H5Sget_simple_extent_dims(space, dims, nullptr) != 2 || dims[0] != hsize_t(global) ||
+        dims[1] != hsize_t(components)) {
+      err << "FieldWriter: " << h5Path << ": " << path << " is " << dims[0] << " x " << dims[1]
+          << ", this run has " << global << " x " << components << "; ";
+      return;
+    }
+    if (owned == 0) return;
+    const hsize_t start[2] = {hsize_t(offset), 0}, count[2] = {hsize_t(owned), hsize_t(components)};
+    Handle mem(H5Screate_simple(2, count, nullptr), H5Sclose);
+    std::vector<long long> rows(size_t(owned * components));
+    if (mem < 0 || H5Sselect_hyperslab(space, H5S_SELECT_SET, start, nullptr, count, nullptr) < 0 ||
+        H5Dread(dset, H5T_NATIVE_LLONG, mem, space, H5P_DEFAULT, rows.data()) < 0)
+      err << "FieldWriter: " << h5Path << ": cannot read " << path << "; ";
+    else if (rows != expected)
+      err << "FieldWriter: " << h5Path << ": " << path
+          << " differs from this run's mesh (another mesh or rank count); ";
+  }
+
   std::string xdmf() const;
   void writeXdmf() const;
 };
 
+void FieldWriter::Impl::init(const std::string& dir, const FieldLayout& l) {
+  comm = l.comm;
+  nodeOffset = l.nodeOffset, nodesOwned = l.nodesOwned, nodesGlobal = l.nodesGlobal;
+  elemOffset = l.elemOffset, elemsOwned = l.elemsOwned, elemsGlobal = l.elemsGlobal;
+  faceOffset = l.faceOffset, facesOwned = l.facesOwned, facesGlobal = l.facesGlobal;
+  directory = dir;
+  h5Path = dir + "/fields.h5";
+  MPI_Comm_rank(comm, &rank);
+
+  // Each rank's rows must lie inside the global range and the owned counts
+  // must add up to the global ones: otherwise rows of the file stay unwritten.
+  std::ostringstream err;
+  auto block = [&](const char* what, long long off, long long own, long long glob) {
+    if (off < 0 || own < 0 || off + own > glob)
+      err << "FieldWriter: " << what << " rows [" << off << ", " << off + own
+          << ") outside [0, " << glob << ") on rank " << rank << "; ";
+  };
+  block("node", l.nodeOffset, l.nodesOwned, l.nodesGlobal);
+  block("element", l.elemOffset, l.elemsOwned, l.elemsGlobal);
+  block("face", l.faceOffset, l.facesOwned, l.facesGlobal);
+  if (l.nodesGlobal <= 0 || l.elemsGlobal <= 0) err << "FieldWriter: empty mesh; ";
+  if (l.hexConnectivity.size() != size_t(8 * std::max(l.elemsOwned, 0LL)) ||
+      l.quadConnectivity.size() != size_t(4 * std::max(l.facesOwned, 0LL)))
+    err << "FieldWriter: connectivity size does not match owned elements/faces; ";
+  auto inRange = [&](long long n) { return n >= 0 && n < l.nodesGlobal; };
+  if (!std::all_of(l.hexConnectivity.begin(), l.hexConnectivity.end(), inRange) ||
+      !std::all_of(l.quadConnectivity.begin(), l.quadConnectivity.end(), inRange))
+    err << "FieldWriter: connectivity refers to a node outside [0, nodesGlobal); ";
+  long long owned[3] = {l.nodesOwned, l.elemsOwned, l.facesOwned}, sums[3];
+  MPI_Allreduce(owned, sums, 3, MPI_LONG_LONG, MPI_SUM, comm);
+  if (sums[0] != l.nodesGlobal || sums[1] != l.elemsGlobal || sums[2] != l.facesGlobal)
+    err << "FieldWriter: owned rows do not add up to the global counts; ";
+  agree(comm, err.str());
+
+  // HDF5 would otherwise print its error stack to stderr; we throw instead.
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+}
+
 FieldWriter::FieldWriter(const std::string& directory, const FieldLayout& l) : impl_(new Impl) {
   Impl& m = *impl_;
-  m.comm = l.comm;
-  m.nodeOffset = l.nodeOffset, m.nodesOwned = l.nodesOwned, m.nodesGlobal = l.nodesGlobal;
-  m.elemOffset = l.elemOffset, m.elemsOwned = l.elemsOwned, m.elemsGlobal = l.elemsGlobal;
-  m.faceOffset = l.faceOffset, m.facesOwned = l.facesOwned, m.facesGlobal = l.facesGlobal;
-  m.directory = directory;
-  m.h5Path = directory + "/fields.h5";
   try {
-    MPI_Comm_rank(m.comm, &m.rank);
-
-    // Each rank's rows must lie inside the global range and the owned counts
-    // must add up to the global ones: otherwise rows of the file stay unwritten.
-    std::ostringstream err;
-    auto block = [&](const char* what, long long off, long long own, long long glob) {
-      if (off < 0 || own < 0 || off + own > glob)
-        err << "FieldWriter: " << what << " rows [" << off << ", " << off + own
-            << ") outside [0, " << glob << ") on rank " << m.rank << "; ";
-    };
-    block("node", l.nodeOffset, l.nodesOwned, l.nodesGlobal);
-    block("element", l.elemOffset, l.elemsOwned, l.elemsGlobal);
-    block("face", l.faceOffset, l.facesOwned, l.facesGlobal);
-    if (l.nodesGlobal <= 0 || l.elemsGlobal <= 0) err << "FieldWriter: empty mesh; ";
-    if (l.hexConnectivity.size() != size_t(8 * std::max(l.elemsOwned, 0LL)) ||
-        l.quadConnectivity.size() != size_t(4 * std::max(l.facesOwned, 0LL)))
-      err << "FieldWriter: connectivity size does not match owned elements/faces; ";
-    auto inRange = [&](long long n) { return n >= 0 && n < l.nodesGlobal; };
-    if (!std::all_of(l.hexConnectivity.begin(), l.hexConnectivity.end(), inRange) ||
-        !std::all_of(l.quadConnectivity.begin(), l.quadConnectivity.end(), inRange))
-      err << "FieldWriter: connectivity refers to a node outside [0, nodesGlobal); ";
-    long long owned[3] = {l.nodesOwned, l.elemsOwned, l.facesOwned}, sums[3];
-    MPI_Allreduce(owned, sums, 3, MPI_LONG_LONG, MPI_SUM, m.comm);
-    if (sums[0] != l.nodesGlobal || sums[1] != l.elemsGlobal || sums[2] != l.facesGlobal)
-      err << "FieldWriter: owned rows do not add up to the global counts; ";
-    agree(m.comm, err.str());
-
-    // HDF5 would otherwise print its error stack to stderr; we throw instead.
-    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-
+    m.init(directory, l);
     Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
     m.check(fapl >= 0 && H5Pset_fapl_mpio(fapl, m.comm, MPI_INFO_NULL) >= 0,
             "cannot set up the MPI-IO file driver");
@@ -194,6 +266,72 @@ FieldWriter::FieldWriter(const std::string& directory, const FieldLayout& l) : i
       m.writeRows("/mesh/quads", H5T_NATIVE_LLONG, H5T_STD_I64LE, l.faceOffset, l.facesOwned,
                   l.facesGlobal, 4, l.quadConnectivity.data());
     m.check(H5Fflush(m.file, H5F_SCOPE_GLOBAL) >= 0, "cannot flush");
+  } catch (...) {
+    if (m.file >= 0) H5Fclose(m.file);
+    delete impl_;
+    throw;
+  }
+}
+
+FieldWriter::FieldWriter(const std::string& directory, const FieldLayout& l, Append append)
+    : impl_(new Impl) {
+  Impl& m = *impl_;
+  try {
+    m.init(directory, l);
+    Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+    m.check(fapl >= 0 && H5Pset_fapl_mpio(fapl, m.comm, MPI_INFO_NULL) >= 0,
+            "cannot set up the MPI-IO file driver");
+    // Every rank learns whether the file opened, so none is left in a collective call.
+    m.file = H5Fopen(m.h5Path.c_str(), H5F_ACC_RDWR, fapl);
+    agree(m.comm, m.file >= 0 ? "" : "FieldWriter: " + m.h5Path + ": cannot open for appending");
+
+    // The file must index nodes as this run does: each rank compares its rows.
+    std::ostringstream err;
+    m.compareRows("/mesh/hexahedra", l.elemOffset, l.elemsOwned, l.elemsGlobal, 8,
+                  l.hexConnectivity, err);
+    if (l.facesGlobal > 0)
+      m.compareRows("/mesh/quads", l.faceOffset, l.facesOwned, l.facesGlobal, 4,
+                    l.quadConnectivity, err);
+    else if (H5Lexists(m.file, "/mesh/quads", H5P_DEFAULT) > 0)
+      err << "FieldWriter: " << m.h5Path << " has contact faces, this run has none; ";
+    agree(m.comm, err.str());
+
+    // Steps up to lastKept are kept (and indexed again); later ones, written
+    // after the checkpoint, are deleted (a collective call, same order on all ranks).
+    for (const std::string& name : m.children("/steps")) {
+      const std::string g = "/steps/" + name;
+      int step = -1;
+      std::from_chars(name.data(), name.data() + name.size(), step);
+      if (step > append.lastKept || step < 0) {
+        m.check(H5Ldelete(m.file, g.c_str(), H5P_DEFAULT) >= 0, "cannot delete " + g);
+        continue;
+      }
+      StepRecord rec{g, 0.0, {}, {}, {}};
+      {
+        Handle attr(H5Aopen_by_name(m.file, g.c_str(), "time", H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+        m.check(attr >= 0 && H5Aread(attr, H5T_NATIVE_DOUBLE, &rec.time) >= 0,
+                "cannot read the time of " + g);
+      }
+      m.readShapes(g + "/nodes", rec.nodal);
+      m.readShapes(g + "/elements", rec.elements);
+      if (m.facesGlobal > 0) m.readShapes(g + "/faces", rec.faces);
+      m.steps.push_back(rec);
+    }
+    // The step a continuation follows on must be there (every rank sees the same file).
+    char last[32];
+    std::snprintf(last, sizeof last, "/steps/%06d", append.lastKept);
+    if (m.steps.empty() || m.steps.back().group != last)
+      throw std::runtime_error("FieldWriter: " + m.h5Path + " does not hold step " + std::to_string(append.lastKept));
+    m.check(H5Fflush(m.file, H5F_SCOPE_GLOBAL) >= 0, "cannot flush");
+    std::string xmfError;
+    if (m.rank == 0) {
+      try {
+        m.writeXdmf();
+      } catch (const std::exception& e) {
+        xmfError = e.what();
+      }
+    }
+    agree(m.comm, xmfError);
   } catch (...) {
     if (m.file >= 0) H5Fclose(m.file);
     delete impl_;

@@ -36,6 +36,14 @@ class FieldWriter {
   // Creates (truncates) DIR/fields.h5 and writes the mesh topology once.
   // Collective over layout.comm. Throws std::runtime_error on I/O failure.
   FieldWriter(const std::string& directory, const FieldLayout& layout);
+  // Restart: opens DIR/fields.h5 written by an earlier run with the same layout
+  // (its connectivity must equal this layout's, row for row), deletes the steps
+  // numbered above `lastKept` (written after the checkpoint the run continues
+  // from) and appends after the rest; DIR/fields.xmf is rewritten for them.
+  struct Append {
+    int lastKept;
+  };
+  FieldWriter(const std::string& directory, const FieldLayout& layout, Append append);
   ~FieldWriter();
   FieldWriter(const FieldWriter&) = delete;
   FieldWriter& operator=(const FieldWriter&) = delete;

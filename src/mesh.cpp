@@ -7,6 +7,7 @@
 #include <Tpetra_Map.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 #include <stdexcept>
 #include <unordered_map>
@@ -72,6 +73,66 @@ std::vector<GO> BoxGenerator::faceNeighbours(GO e) const {
       if (m[d] < 0 || m[d] >= n_[d]) continue;
       nb.push_back(m[0] + n_[0] * (m[1] + n_[1] * m[2]));
     }
+  return nb;
+}
+
+// ---------------------------------------------------------------- annulus generator
+
+AnnulusGenerator::AnnulusGenerator(std::array<double, 3> center, double innerRadius, double outerRadius,
+                                   double length, std::array<int, 3> cells)
+    : center_(center), ri_(innerRadius), ro_(outerRadius), length_(length), n_{cells[0], cells[1], cells[2]} {}
+
+GO AnnulusGenerator::numElements() const { return n_[0] * n_[1] * n_[2]; }
+GO AnnulusGenerator::numNodes() const { return (n_[0] + 1) * n_[1] * (n_[2] + 1); }
+
+std::vector<std::string> AnnulusGenerator::faceNames() const { return {"inner", "outer", "zmin", "zmax"}; }
+
+std::array<GO, 3> AnnulusGenerator::ijk(GO e) const {
+  return {e % n_[0], (e / n_[0]) % n_[1], e / (n_[0] * n_[1])};
+}
+
+GO AnnulusGenerator::node(GO i, GO j, GO k) const {
+  return i + (n_[0] + 1) * ((j % n_[1]) + n_[1] * k);
+}
+
+std::array<GO, 8> AnnulusGenerator::elementNodes(GO e) const {
+  const auto [i, j, k] = ijk(e);
+  return {node(i, j, k),         node(i + 1, j, k),         node(i + 1, j + 1, k),
+          node(i, j + 1, k),     node(i, j, k + 1),         node(i + 1, j, k + 1),
+          node(i + 1, j + 1, k + 1), node(i, j + 1, k + 1)};
+}
+
+std::array<double, 3> AnnulusGenerator::nodeCoordinates(GO n) const {
+  const GO sr = n_[0] + 1;
+  const GO i = n % sr, j = (n / sr) % n_[1], k = n / (sr * n_[1]);
+  const double r = i == n_[0] ? ro_ : ri_ + (ro_ - ri_) * double(i) / double(n_[0]);
+  const double theta = 2 * M_PI * double(j) / double(n_[1]);
+  const double z = k == n_[2] ? length_ : length_ * double(k) / double(n_[2]);
+  return {center_[0] + r * std::cos(theta), center_[1] + r * std::sin(theta), center_[2] + z};
+}
+
+std::vector<BoundaryFace> AnnulusGenerator::boundaryFaces(GO e) const {
+  const auto [i, j, k] = ijk(e);
+  const auto n = elementNodes(e);
+  std::vector<BoundaryFace> f;
+  // As the box's xmin, xmax, zmin, zmax: (radial, circumferential, axial) plays (x, y, z).
+  if (i == 0) f.push_back({"inner", {n[0], n[4], n[7], n[3]}});
+  if (i == n_[0] - 1) f.push_back({"outer", {n[1], n[2], n[6], n[5]}});
+  if (k == 0) f.push_back({"zmin", {n[0], n[3], n[2], n[1]}});
+  if (k == n_[2] - 1) f.push_back({"zmax", {n[4], n[5], n[6], n[7]}});
+  return f;
+}
+
+std::vector<GO> AnnulusGenerator::faceNeighbours(GO e) const {
+  const auto [i, j, k] = ijk(e);
+  auto id = [&](GO a, GO b, GO c) { return a + n_[0] * (((b + n_[1]) % n_[1]) + n_[1] * c); };
+  std::vector<GO> nb;
+  if (i > 0) nb.push_back(id(i - 1, j, k));
+  if (i < n_[0] - 1) nb.push_back(id(i + 1, j, k));
+  nb.push_back(id(i, j - 1, k));  // closed around the circumference
+  if (n_[1] > 2) nb.push_back(id(i, j + 1, k));
+  if (k > 0) nb.push_back(id(i, j, k - 1));
+  if (k < n_[2] - 1) nb.push_back(id(i, j, k + 1));
   return nb;
 }
 

@@ -52,6 +52,32 @@ class BoxGenerator : public MeshGenerator {
   std::array<GO, 3> ijk(GO element) const;
 };
 
+// Hollow cylinder along +z (the rubber coating of a pinch roller): Cells =
+// {radial, circumferential, axial} bricks between Inner and Outer Radius, from
+// Center (the axis point at the zmin end) over Length. Closed around the
+// circumference (nodes at angle 2 pi are those at 0). Faces inner, outer,
+// zmin, zmax. Brick axes (radial, circumferential, axial) are right-handed, so
+// every brick has a positive Jacobian.
+class AnnulusGenerator : public MeshGenerator {
+ public:
+  AnnulusGenerator(std::array<double, 3> center, double innerRadius, double outerRadius, double length,
+                   std::array<int, 3> cells);
+  GO numElements() const override;
+  GO numNodes() const override;
+  std::vector<std::string> faceNames() const override;
+  std::array<GO, 8> elementNodes(GO element) const override;
+  std::array<double, 3> nodeCoordinates(GO node) const override;
+  std::vector<BoundaryFace> boundaryFaces(GO element) const override;
+  std::vector<GO> faceNeighbours(GO element) const override;
+
+ private:
+  std::array<double, 3> center_;
+  double ri_, ro_, length_;
+  std::array<GO, 3> n_;  // radial, circumferential, axial cells
+  std::array<GO, 3> ijk(GO element) const;
+  GO node(GO i, GO j, GO k) const;  // j taken modulo the circumferential count
+};
+
 // This rank's part of the body. Node numbering is "overlapped": the nodes this
 // rank owns come first (in owned-map order), then the ghost nodes it shares.
 struct Mesh {

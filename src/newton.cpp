@@ -9,10 +9,13 @@
 #include <Stratimikos_DefaultLinearSolverBuilder.hpp>
 #include <Stratimikos_MueLuHelpers.hpp>
 #include <Teuchos_AbstractFactoryStd.hpp>
+#include <Teuchos_oblackholestream.hpp>
 #include <Thyra_Ifpack2PreconditionerFactory.hpp>
 #include <Thyra_LinearOpWithSolveFactoryHelpers.hpp>
 #include <Thyra_StateFuncModelEvaluatorBase.hpp>
 #include <Thyra_TpetraThyraWrappers.hpp>
+
+#include "errors.hpp"
 
 namespace capstan {
 
@@ -180,6 +183,41 @@ struct NewtonSolver::Impl {
   RCP<BodyModel> model;
   double linearSeconds = 0;
   Impl(Assembly& a, const Teuchos::ParameterList& s) : assembly(a), solver(s) {}
+
+  RCP<Teuchos::ParameterList> noxParameters(const RCP<NOX::Observer>& observer) const {
+    auto params = Teuchos::parameterList("NOX");
+    params->set("Nonlinear Solver", "Line Search Based");
+    const std::string ls = solver.get<std::string>("Line Search");
+    auto& lsp = params->sublist("Line Search");
+    lsp.set("Method", ls);
+    // Backtrack (the default) halves the step until 0.5 |R|^2 decreases. An
+    // evaluation that inverts an element (det F <= 0 at a Gauss point) returns
+    // |R| = 1e150 per dof (Assembly::evaluate), so the line search backs off
+    // from it like from any increase, and NOX's FiniteValue test stops a solve
+    // that produces NaN. Contact status chattering (points entering and
+    // leaving contact between iterations, a residual that will not decrease)
+    // ends in the line search's failure, the Stagnation test or Max Newton
+    // Iterations: the solve reports failure and the step is cut, which is the
+    // remedy for both (a smaller increment moves fewer points across the
+    // kink). A failed line search takes no step (Recovery Step 0): NOX's
+    // default takes the full Newton step anyway, into inverted states where the
+    // tangent is singular (the direct solver throws), and at round-off, where no
+    // step decreases |R|, it wanders until Stagnation stops it (H5: 70 Newton
+    // iterations instead of 42, same answer; tests/integration/line_search.py).
+    if (ls == "Backtrack") {
+      lsp.sublist("Backtrack").set("Max Iters", 20);
+      lsp.sublist("Backtrack").set("Recovery Step", 0.0);
+    }
+    auto& lin = params->sublist("Direction").sublist("Newton").sublist("Linear Solver");
+    lin.set("Tolerance", solver.get<double>("Linear Tolerance"));
+    params->sublist("Printing").set("Output Information", 0);
+    // NOX writes some notes (e.g. "line search failed") to its output stream
+    // whatever the print level; capstan reports the outcome itself.
+    params->sublist("Printing").set<RCP<std::ostream>>("Output Stream", rcp(new Teuchos::oblackholestream));
+    params->sublist("Solver Options").set<RCP<NOX::Observer>>("Observer", observer);
+    params->setParameters(solver.sublist("NOX"));
+    return params;
+  }
 };
 
 NewtonSolver::NewtonSolver(Assembly& assembly, const Teuchos::ParameterList& solver)
@@ -196,9 +234,24 @@ NewtonSolver::NewtonSolver(Assembly& assembly, const Teuchos::ParameterList& sol
                                                solver.get<std::string>("Preconditioner") != "Jacobi"
                                            ? rigidBodyModes(assembly)
                                            : Teuchos::null);
-  builder.setParameterList(Teuchos::rcp(new Teuchos::ParameterList(impl_->strat)));
-  impl_->lows = builder.createLinearSolveStrategy("");
+  // The scene's Stratimikos and NOX sublists are checked here, before the run
+  // starts: Stratimikos validates its list, and building a NOX solver once
+  // checks NOX's choices (solver, direction, line search names).
+  try {
+    builder.setParameterList(Teuchos::rcp(new Teuchos::ParameterList(impl_->strat)));
+    impl_->lows = builder.createLinearSolveStrategy("");
+  } catch (const std::exception& e) {
+    throw InputError("parameter 'Solver/Stratimikos': " + trilinosMessage(e.what()));
+  }
   impl_->model = rcp(new BodyModel(assembly, impl_->lows));
+  try {
+    auto guess = rcp(new Vector(assembly.dofMap()));
+    NOX::Thyra::Vector x0(Thyra::createVector(guess, impl_->model->get_x_space()));
+    auto group = rcp(new NOX::Thyra::Group(x0, impl_->model));
+    NOX::Solver::buildSolver(group, rcp(new NOX::StatusTest::MaxIters(1)), impl_->noxParameters(rcp(new History)));
+  } catch (const std::exception& e) {
+    throw InputError("parameter 'Solver/NOX': " + trilinosMessage(e.what()));
+  }
 }
 
 NewtonSolver::~NewtonSolver() = default;
@@ -233,18 +286,8 @@ NewtonResult NewtonSolver::solve(Vector& u, double tolerance) {
   NOX::Thyra::Vector x0(Thyra::createVector(guess, impl_->model->get_x_space()));
   auto group = rcp(new NOX::Thyra::Group(x0, impl_->model));
 
-  auto params = Teuchos::parameterList("NOX");
-  params->set("Nonlinear Solver", "Line Search Based");
-  const std::string ls = impl_->solver.get<std::string>("Line Search");
-  auto& lsp = params->sublist("Line Search");
-  lsp.set("Method", ls);
-  if (ls == "Backtrack") lsp.sublist("Backtrack").set("Max Iters", 20);
-  auto& lin = params->sublist("Direction").sublist("Newton").sublist("Linear Solver");
-  lin.set("Tolerance", impl_->solver.get<double>("Linear Tolerance"));
-  params->sublist("Printing").set("Output Information", 0);
   auto history = rcp(new History);
-  params->sublist("Solver Options").set<RCP<NOX::Observer>>("Observer", history);
-  params->setParameters(impl_->solver.sublist("NOX"));
+  auto params = impl_->noxParameters(history);
 
   auto normF = rcp(new NOX::StatusTest::NormF(tolerance));
   auto maxIters = rcp(new NOX::StatusTest::MaxIters(impl_->solver.get<int>("Max Newton Iterations")));

@@ -1,9 +1,21 @@
 #include "scene.hpp"
 
+#include <Teuchos_ParameterEntryXMLConverterDB.hpp>
 #include <Teuchos_StrUtils.hpp>
+#include <Teuchos_StringInputSource.hpp>
 #include <Teuchos_XMLParameterListHelpers.hpp>
+#include <Teuchos_XMLParameterListReader.hpp>
 
+#include <cerrno>
+#include <climits>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+
+#include <algorithm>
+#include <cmath>
 #include <fstream>
+#include <iomanip>
 #include <set>
 #include <sstream>
 
@@ -29,6 +41,11 @@ Array<double> vec3(double a, double b, double c) { return Teuchos::tuple(a, b, c
 ParameterList validParameters() {
   ParameterList p("Scene");
   p.set("Title", std::string(""), "Free text, copied to summary.json");
+  p.set("Accuracy", std::string("Scene"),
+        "Scene (the mesh and tolerances as written) | Draft (the scene's mesh, Newton "
+        "tolerance 1e-6: quick look) | Standard (twice the scene's cells in every direction) | "
+        "Fine (four times). Solver parameters the scene sets itself win. Measured errors and "
+        "costs on G1 and H1: docs/accuracy.md");
 
   auto& mesh = p.sublist("Mesh", false, "The rubber body's mesh");
   mesh.set("Type", std::string("Box"), "Box (structured brick mesh; faces xmin xmax ymin ymax zmin zmax)");
@@ -44,6 +61,11 @@ ParameterList validParameters() {
           "eps1 > 0: pressure penalty of the condensed Newton step. The converged state "
           "(v_e = V_e) does not depend on it; values below Solver/Minimum Solve Penalty "
           "are raised to it in the linear solves (see docs/numerics.md)");
+
+  auto& loads = p.sublist("Loads", false, "Loads on the body besides its supports and capstans");
+  loads.set("Body Force", vec3(0, 0, 0),
+            "Dead load {bx, by, bz} per unit reference volume (e.g. rho g), reached at the end "
+            "of the run: b t / (Steps x Step Size). Zero: no body-force kernel runs");
 
   auto& sup = p.sublist("Supports", false, "Boundary supports, one sublist per support, any name");
   auto& s = sup.sublist(kAnyName, false, "A support");
@@ -121,6 +143,9 @@ ParameterList validParameters() {
   auto& out = p.sublist("Output", false, "Where and what to write");
   out.set("Directory", std::string("out"), "Output directory (created if missing)");
   out.set("Write Fields", true, "Write fields.h5 + fields.xmf");
+  out.set("Checkpoint Every", 0,
+          "Write a checkpoint (Directory/checkpoint/) after every N-th converged step, for "
+          "`capstan run SCENE --restart DIR`; only the newest is kept. 0 = never");
   return p;
 }
 
@@ -195,6 +220,265 @@ struct Validator {
   }
 };
 
+// Strict readings of numbers as written in the scene or in --set. Teuchos reads
+// them with a stream and keeps whatever prefix parses ("5.5" as the int 5,
+// "abc" or "nan" as 0.0), so every number is checked here first.
+std::string trimmed(const std::string& s) {
+  const auto a = s.find_first_not_of(" \t\r\n"), b = s.find_last_not_of(" \t\r\n");
+  return a == std::string::npos ? "" : s.substr(a, b - a + 1);
+}
+
+// 0.01, not 1.00000000000000002e-02: 6 digits where they read back the same, else 17.
+std::string shortest(double x) {
+  std::ostringstream brief, full;
+  brief << x;
+  full << std::setprecision(17) << x;
+  return std::strtod(brief.str().c_str(), nullptr) == x ? brief.str() : full.str();
+}
+
+std::string brief(double x) {  // 6 digits, for descriptions
+  std::ostringstream out;
+  out << x;
+  return out.str();
+}
+
+// A finite double written in decimal (no hex, inf or nan), or false.
+bool readDouble(const std::string& text, double& x) {
+  const std::string t = trimmed(text);
+  if (t.empty() || t.find_first_not_of("0123456789+-.eE") != std::string::npos) return false;
+  errno = 0;
+  char* end = nullptr;
+  x = std::strtod(t.c_str(), &end);
+  return end == t.c_str() + t.size() && errno != ERANGE && std::isfinite(x);
+}
+
+bool readInt(const std::string& text, int& x) {
+  const std::string t = trimmed(text);
+  if (t.empty() || t.find_first_not_of("0123456789+-") != std::string::npos) return false;
+  errno = 0;
+  char* end = nullptr;
+  const long long v = std::strtoll(t.c_str(), &end, 10);
+  if (end != t.c_str() + t.size() || errno == ERANGE || v < INT_MIN || v > INT_MAX) return false;
+  x = int(v);
+  return true;
+}
+
+// "{a, b, c}" (or "{}") with every element read by readDouble / readInt.
+template <class T>
+bool readArray(const std::string& text, Array<T>& out) {
+  const std::string t = trimmed(text);
+  if (t.size() < 2 || t.front() != '{' || t.back() != '}') return false;
+  out.clear();
+  const std::string inner = t.substr(1, t.size() - 2);
+  if (trimmed(inner).empty()) return true;
+  std::stringstream ss(inner);
+  for (std::string item; std::getline(ss, item, ',');) {
+    T x;
+    bool ok;
+    if constexpr (std::is_same_v<T, int>) ok = readInt(item, x);
+    else ok = readDouble(item, x);
+    if (!ok) return false;
+    out.push_back(x);
+  }
+  return inner.back() != ',';  // "{1, 2,}": a missing element
+}
+
+// Why a number parameter's text does not read as its type, or "".
+std::string numberError(const std::string& type, const std::string& value) {
+  double d;
+  int i;
+  Array<double> ad;
+  Array<int> ai;
+  if (type == "double" && !readDouble(value, d))
+    return "'" + value + "' is not a finite number (type double)";
+  if (type == "int" && !readInt(value, i))
+    return "'" + value + "' is not an integer in the range of int (type int)";
+  if (type == "Array(double)" && !readArray(value, ad))
+    return "'" + value + "' is not a list {x, y, ...} of finite numbers (type Array(double))";
+  if (type == "Array(int)" && !readArray(value, ai))
+    return "'" + value + "' is not a list {i, j, ...} of integers (type Array(int))";
+  return "";
+}
+
+// Deepest element nesting of an XML text (comments, processing instructions,
+// declarations and quoted attribute values skipped). The Teuchos reader
+// recurses per level and a deep enough file overflows the stack, so depth is
+// checked on the raw text first.
+int nestingDepth(const std::string& x) {
+  int depth = 0, deepest = 0;
+  size_t i = 0;
+  auto skipPast = [&](const char* end) {
+    const size_t p = x.find(end, i);
+    i = p == std::string::npos ? x.size() : p + std::strlen(end);
+  };
+  while ((i = x.find('<', i)) != std::string::npos) {
+    if (x.compare(i, 4, "<!--") == 0) skipPast("-->");
+    else if (x.compare(i, 9, "<![CDATA[") == 0) skipPast("]]>");
+    else if (x.compare(i, 2, "<?") == 0) skipPast("?>");
+    else if (x.compare(i, 2, "<!") == 0) skipPast(">");
+    else if (x.compare(i, 2, "</") == 0) {
+      --depth;
+      skipPast(">");
+    } else {
+      char quote = 0;
+      size_t j = i + 1;
+      for (; j < x.size(); ++j) {
+        if (quote) {
+          if (x[j] == quote) quote = 0;
+        } else if (x[j] == '"' || x[j] == '\'') {
+          quote = x[j];
+        } else if (x[j] == '>') {
+          break;
+        }
+      }
+      if (j >= x.size() || x[j - 1] != '/') deepest = std::max(deepest, ++depth);
+      i = j + 1;
+    }
+  }
+  return deepest;
+}
+
+// The scene's XML elements before Teuchos converts them: only ParameterList and
+// Parameter, each with a name (sublists may be unnamed only at the root), no
+// name twice in one list, and numbers that read exactly as their type.
+void checkXml(const Teuchos::XMLObject& list, const std::string& path, const Validator& v) {
+  std::set<std::string> names;
+  for (int i = 0; i < list.numChildren(); ++i) {
+    const auto& child = list.getChild(i);
+    const std::string& tag = child.getTag();
+    if (tag != "ParameterList" && tag != "Parameter")
+      v.fail(path, "unknown XML element <" + tag + "> (a scene has ParameterList and Parameter elements)");
+    if (!child.hasAttribute("name"))
+      v.fail(path, "a <" + tag + "> without a name attribute" + (path.empty() ? " at the top level" : ""));
+    const std::string name = child.getAttribute("name");
+    const std::string here = path.empty() ? name : path + "/" + name;
+    if (!names.insert(name).second) v.fail(here, "given twice");
+    if (tag == "ParameterList") {
+      checkXml(child, here, v);
+      continue;
+    }
+    if (!child.hasAttribute("type")) v.fail(here, "no type attribute");
+    if (!child.hasAttribute("value")) v.fail(here, "no value attribute");
+    const std::string error = numberError(child.getAttribute("type"), child.getAttribute("value"));
+    if (!error.empty()) v.fail(here, error);
+    try {  // what Teuchos makes of it (unknown types, bad bools, ...), with the path
+      Teuchos::ParameterEntryXMLConverterDB::convertXML(child);
+    } catch (const std::exception& e) {
+      v.fail(here, trilinosMessage(e.what()));
+    }
+  }
+}
+
+Teuchos::RCP<ParameterList> readXml(const std::string& content, const Validator& v) {
+  constexpr int kMaxDepth = 64;
+  if (nestingDepth(content) > kMaxDepth)
+    v.fail("", "malformed scene XML: elements nested deeper than " + std::to_string(kMaxDepth) + " levels");
+  Teuchos::XMLObject xml;
+  try {
+    xml = Teuchos::StringInputSource(content).getObject();
+  } catch (const std::exception& e) {
+    v.fail("", "malformed scene XML: " + trilinosMessage(e.what()));
+  }
+  if (xml.isEmpty() || xml.getTag() != "ParameterList")
+    v.fail("", std::string("malformed scene XML: the root element must be <ParameterList>") +
+                   (xml.isEmpty() ? "" : ", not <" + xml.getTag() + ">"));
+  checkXml(xml, "", v);
+  auto user = Teuchos::rcp(new ParameterList);
+  try {
+    Teuchos::XMLParameterListReader reader;
+    reader.setAllowsDuplicateSublists(false);
+    user->setParameters(reader.toParameterList(xml));
+  } catch (const std::exception& e) {
+    v.fail("", "malformed scene XML: " + trilinosMessage(e.what()));
+  }
+  return user;
+}
+
+// Golden-section minimum of a convex function on [lo, hi].
+template <class F>
+double convexMinimum(F f, double lo, double hi) {
+  const double g = 0.5 * (std::sqrt(5.0) - 1);
+  double a = lo, b = hi, c = b - g * (b - a), d = a + g * (b - a), fc = f(c), fd = f(d);
+  for (int it = 0; it < 100 && b - a > 1e-12 * (std::fabs(a) + std::fabs(b) + 1e-300); ++it) {
+    if (fc < fd) {
+      b = d, d = c, fd = fc, c = b - g * (b - a), fc = f(c);
+    } else {
+      a = c, c = d, fc = fd, d = a + g * (b - a), fd = f(d);
+    }
+  }
+  return std::min({f(lo), f(hi), fc, fd});
+}
+
+// A capstan that can never touch its contact faces is most likely a typo in
+// Axis Point or Radius. Conservative: the faces' bounding box is enlarged by
+// the body's largest extent (however it deforms) plus the farthest any
+// Displacement support moves over the run, and the capstan's axis is followed
+// over the whole run (the axis point moves with Velocity until Steps x Step
+// Size). Only when even that box stays farther than Radius from every axis
+// position is the input flagged. The distance from a box to a line, and its
+// minimum over the axis' travel, are convex in the line's parameter and in t.
+void warnUnreachable(Scene& sc, const CapstanSpec& c) {
+  const auto& m = sc.mesh;
+  const double T = sc.steps * sc.stepSize;
+  double size = 0, travel = 0;
+  for (int i = 0; i < 3; ++i) size = std::max(size, m.max[i] - m.min[i]);
+  for (const auto& s : sc.supports)
+    if (s.type == "Displacement") {
+      double v2 = 0;
+      for (int i = 0; i < 3; ++i) v2 += s.components[i] ? s.velocity[i] * s.velocity[i] : 0.0;
+      travel = std::max(travel, std::sqrt(v2) * T);
+    }
+  std::array<double, 3> lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  for (const auto& face : c.contactFaces) {
+    const int axis = face[0] - 'x';
+    const bool isMax = face.substr(1) == "max";
+    for (int i = 0; i < 3; ++i) {
+      const double a = i == axis ? (isMax ? m.max[i] : m.min[i]) : m.min[i];
+      const double b = i == axis ? a : m.max[i];
+      lo[i] = std::min(lo[i], a), hi[i] = std::max(hi[i], b);
+    }
+  }
+  const double grow = size + travel;
+  for (int i = 0; i < 3; ++i) lo[i] -= grow, hi[i] += grow;
+  std::array<double, 3> b = c.axisDirection;
+  const double nb = std::sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+  for (double& x : b) x /= nb;
+  auto pointToBox = [&](const std::array<double, 3>& p) {
+    double d2 = 0;
+    for (int i = 0; i < 3; ++i) {
+      const double e = std::max({lo[i] - p[i], 0.0, p[i] - hi[i]});
+      d2 += e * e;
+    }
+    return std::sqrt(d2);
+  };
+  auto lineToBox = [&](double t) {
+    std::array<double, 3> a;
+    for (int i = 0; i < 3; ++i) a[i] = c.axisPoint[i] + c.velocity[i] * t;
+    // The nearest point of the line lies between the projections of the box's corners.
+    double s0 = 1e300, s1 = -1e300;
+    for (int k = 0; k < 8; ++k) {
+      double s = 0;
+      for (int i = 0; i < 3; ++i) s += (((k >> i) & 1 ? hi[i] : lo[i]) - a[i]) * b[i];
+      s0 = std::min(s0, s), s1 = std::max(s1, s);
+    }
+    return convexMinimum(
+        [&](double s) {
+          return pointToBox({a[0] + s * b[0], a[1] + s * b[1], a[2] + s * b[2]});
+        },
+        s0, s1);
+  };
+  const double closest = convexMinimum(lineToBox, 0.0, T);
+  if (closest > c.radius) {
+    std::string faces;
+    for (const auto& f : c.contactFaces) faces += (faces.empty() ? "" : " ") + f;
+    sc.warnings.push_back(sc.file + ": parameter 'Capstans/" + c.name + "': the capstan can never touch its "
+                          "Contact Faces (" + faces + "): over the whole run its axis stays " +
+                          brief(closest + grow) + " or more from them, beyond its Radius " +
+                          shortest(c.radius) + " plus the body's size and support travel (" +
+                          brief(grow) + "); check Axis Point, Velocity and Radius");
+  }
+}
+
 // Walks PATH (sublists separated by '/') and sets VALUE with the parameter's type,
 // taken from the scene or from the valid list.
 void applySet(ParameterList& scene, const ParameterList& valid, const std::string& file,
@@ -224,18 +508,24 @@ void applySet(ParameterList& scene, const ParameterList& valid, const std::strin
   const auto& t = typed->getAny(false).type();
   try {
     auto number = [&](auto parsed) {
-      std::istringstream in(value);
-      in >> parsed;
-      if (in.fail() || !(in >> std::ws).eof()) throw std::invalid_argument("not a number");
+      bool ok;
+      if constexpr (std::is_same_v<decltype(parsed), int>) ok = readInt(value, parsed);
+      else ok = readDouble(value, parsed);
+      if (!ok) throw std::invalid_argument("not a number");
       return parsed;
     };
     if (t == typeid(double)) list->set(name, number(0.0));
     else if (t == typeid(int)) list->set(name, number(0));
     else if (t == typeid(bool)) list->set(name, value == "true" || value == "1");
     else if (t == typeid(std::string)) list->set(name, value);
-    else if (t == typeid(Array<double>)) list->set(name, Teuchos::fromStringToArray<double>(value));
-    else if (t == typeid(Array<int>)) list->set(name, Teuchos::fromStringToArray<int>(value));
-    else throw std::invalid_argument("type not settable");
+    else if (t == typeid(Array<double>) || t == typeid(Array<int>)) {
+      Array<double> ad;
+      Array<int> ai;
+      if (t == typeid(Array<int>) ? !readArray(value, ai) : !readArray(value, ad))
+        throw std::invalid_argument("not a list");
+      if (t == typeid(Array<int>)) list->set(name, ai);
+      else list->set(name, ad);
+    } else throw std::invalid_argument("type not settable");
   } catch (const std::exception& e) {
     throw InputError(file + ": --set: parameter '" + path + "': cannot read '" + value + "' as " +
                      typed->getAny(false).typeName());
@@ -260,13 +550,15 @@ std::array<T, 3> three(const ParameterList& l, const std::string& name, const Va
   const auto& a = l.get<Array<T>>(name);
   if (a.size() != 3)
     v.fail(path + "/" + name, "expected 3 values, got " + std::to_string(a.size()));
+  for (const T& x : a)
+    if (!std::isfinite(double(x))) v.fail(path + "/" + name, "must be finite numbers");
   return {a[0], a[1], a[2]};
 }
 
 double positive(const ParameterList& l, const std::string& name, const Validator& v,
                 const std::string& path) {
   const double x = l.get<double>(name);
-  if (!(x > 0) || !std::isfinite(x)) v.fail(path + "/" + name, "must be a finite number > 0, got " + Teuchos::toString(x));
+  if (!(x > 0) || !std::isfinite(x)) v.fail(path + "/" + name, "must be a finite number > 0, got " + shortest(x));
   return x;
 }
 
@@ -284,32 +576,63 @@ std::vector<std::string> splitNames(const std::string& s) {
   return names;
 }
 
+// Accuracy presets (docs/accuracy.md). The measured studies show the mesh is the
+// knob that sets the error of every quantity of interest (load steps, penalties
+// with the augmented Lagrangian and the Newton tolerance below 1e-6 change the
+// answers by less than 1e-9), so a preset scales Mesh/Cells; Draft instead keeps
+// the mesh and loosens the Newton tolerance, which costs no accuracy worth
+// measuring and about a third of the time. Applied to the user's list before
+// defaults are filled in, so solver parameters the scene (or --set) names win.
+void applyAccuracyPreset(ParameterList& user, const Validator& v) {
+  if (!user.isType<std::string>("Accuracy")) return;  // absent, or a type error check() reports
+  const std::string preset = user.get<std::string>("Accuracy");
+  int refine = 1;
+  if (preset == "Draft") {
+    auto& solver = user.sublist("Solver");
+    if (!solver.isParameter("Newton Relative Tolerance")) solver.set("Newton Relative Tolerance", 1e-6);
+  } else if (preset == "Standard") {
+    refine = 2;
+  } else if (preset == "Fine") {
+    refine = 4;
+  } else if (preset != "Scene") {
+    v.fail("Accuracy", "'" + preset + "' is not an accuracy preset (Scene, Draft, Standard, Fine)");
+  }
+  if (refine != 1 && user.isSublist("Mesh") && user.sublist("Mesh").isType<Array<int>>("Cells")) {
+    Array<int> cells = user.sublist("Mesh").get<Array<int>>("Cells");
+    for (int& n : cells) {
+      if (n > 1000000) v.fail("Accuracy", "'" + preset + "' would refine Mesh/Cells beyond 1e6 per direction");
+      n *= refine;
+    }
+    user.sublist("Mesh").set("Cells", cells);
+  }
+}
+
 }  // namespace
 
 Scene loadScene(const std::string& file, const std::vector<std::string>& sets,
                 const std::string& outputOverride) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec)) throw InputError(file + ": a directory, not a scene file");
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InputError(file + ": cannot open the scene file");
+  std::string content((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw InputError(file + ": cannot read the scene file");
+  return parseScene(content, file, sets, outputOverride);
+}
+
+Scene parseScene(const std::string& content, const std::string& file, const std::vector<std::string>& sets,
+                 const std::string& outputOverride) {
   Validator v{file};
-  {
-    std::ifstream in(file);
-    if (!in) throw InputError(file + ": cannot open the scene file");
-    std::string content((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (content.find_first_not_of(" \t\r\n") == std::string::npos)
-      throw InputError(file + ": the scene file is empty");
-    for (unsigned char ch : content)
-      if (ch == 0 || (ch < 32 && ch != '\n' && ch != '\r' && ch != '\t'))
-        throw InputError(file + ": not a text XML file (binary data)");
-  }
-  Teuchos::RCP<ParameterList> user;
-  try {
-    user = Teuchos::getParametersFromXmlFile(file);
-  } catch (const std::exception& e) {
-    std::string what = e.what();
-    if (what.size() > 400) what = what.substr(0, 400) + "...";
-    throw InputError(file + ": malformed scene XML: " + what);
-  }
+  if (content.find_first_not_of(" \t\r\n") == std::string::npos)
+    throw InputError(file + ": the scene file is empty");
+  for (unsigned char ch : content)
+    if (ch == 0 || (ch < 32 && ch != '\n' && ch != '\r' && ch != '\t'))
+      throw InputError(file + ": not a text XML file (binary data)");
+  Teuchos::RCP<ParameterList> user = readXml(content, v);
   const ParameterList valid = validParameters();
   for (const auto& s : sets) applySet(*user, valid, file, s);
   if (!outputOverride.empty()) user->sublist("Output").set("Directory", outputOverride);
+  applyAccuracyPreset(*user, v);
   v.check(*user, valid, "");
 
   Scene sc;
@@ -329,6 +652,12 @@ Scene loadScene(const std::string& file, const std::vector<std::string>& sets,
       v.fail("Mesh/Max", "each component must exceed Mesh/Min (zero or negative size)");
     if (sc.mesh.cells[d] < 1) v.fail("Mesh/Cells", "each count must be >= 1");
   }
+  {
+    // Local dof ids are ints: 3 x nodes must stay below 2^31.
+    const double nodes = double(sc.mesh.cells[0] + 1.0) * (sc.mesh.cells[1] + 1.0) * (sc.mesh.cells[2] + 1.0);
+    if (3 * nodes > double(INT_MAX))
+      v.fail("Mesh/Cells", "too many cells: " + shortest(nodes) + " nodes, capstan indexes at most 2^31 / 3");
+  }
   const std::set<std::string> faceNames = {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
 
   const auto& mat = P.sublist("Material");
@@ -336,6 +665,10 @@ Scene loadScene(const std::string& file, const std::vector<std::string>& sets,
     v.fail("Material/Model", "'" + mat.get<std::string>("Model") + "' is not a model (Incompressible Neo-Hookean)");
   sc.c = positive(mat, "c", v, "Material");
   sc.pressurePenalty = positive(mat, "Pressure Penalty", v, "Material");
+
+  sc.bodyForce = three<double>(P.sublist("Loads"), "Body Force", v, "Loads");
+  for (double b : sc.bodyForce)
+    if (!std::isfinite(b)) v.fail("Loads/Body Force", "must be finite numbers");
 
   const auto& sups = P.sublist("Supports");
   for (auto it = sups.begin(); it != sups.end(); ++it) {
@@ -364,10 +697,17 @@ Scene loadScene(const std::string& file, const std::vector<std::string>& sets,
     cs.radius = positive(c, "Radius", v, path);
     cs.axisPoint = three<double>(c, "Axis Point", v, path);
     cs.axisDirection = three<double>(c, "Axis Direction", v, path);
-    const double n2 = cs.axisDirection[0] * cs.axisDirection[0] + cs.axisDirection[1] * cs.axisDirection[1] + cs.axisDirection[2] * cs.axisDirection[2];
-    if (!(n2 > 0) || !std::isfinite(n2)) v.fail(path + "/Axis Direction", "must be a non-zero vector");
+    {
+      // Scaled by a power of two (exact: a direction of ordinary size keeps
+      // its bits), so that 1e-200 or 1e200 do not under- or overflow |beta|^2.
+      auto& b = cs.axisDirection;
+      const double m = std::max({std::fabs(b[0]), std::fabs(b[1]), std::fabs(b[2])});
+      if (!(m > 0)) v.fail(path + "/Axis Direction", "must be a non-zero vector, got {0, 0, 0}");
+      for (double& x : b) x = std::ldexp(x, -std::ilogb(m));
+    }
     cs.velocity = three<double>(c, "Velocity", v, path);
     cs.angularVelocity = c.get<double>("Angular Velocity");
+    if (!std::isfinite(cs.angularVelocity)) v.fail(path + "/Angular Velocity", "must be a finite number");
     cs.contactFaces = splitNames(c.get<std::string>("Contact Faces"));
     if (cs.contactFaces.empty()) v.fail(path + "/Contact Faces", "name at least one face");
     for (const auto& f : cs.contactFaces)
@@ -449,6 +789,10 @@ Scene loadScene(const std::string& file, const std::vector<std::string>& sets,
   sc.outputDirectory = out.get<std::string>("Directory");
   if (sc.outputDirectory.empty()) v.fail("Output/Directory", "must not be empty");
   sc.writeFields = out.get<bool>("Write Fields");
+  sc.checkpointEvery = out.get<int>("Checkpoint Every");
+  if (sc.checkpointEvery < 0)
+    v.fail("Output/Checkpoint Every", "must be >= 0 (0 = no checkpoints), got " + std::to_string(sc.checkpointEvery));
+  for (const auto& c : sc.capstans) warnUnreachable(sc, c);
   return sc;
 }
 

@@ -41,6 +41,7 @@ struct Scene {
   std::string file, title;
   MeshSpec mesh;
   double c = 1, pressurePenalty = 1e-3;
+  std::array<double, 3> bodyForce{};  // Loads/Body Force at the end of the run
   std::vector<SupportSpec> supports;
   std::vector<CapstanSpec> capstans;
   int steps = 1;
@@ -48,6 +49,10 @@ struct Scene {
   Teuchos::ParameterList solver;   // the resolved Solver sublist
   std::string outputDirectory;
   bool writeFields = true;
+  int checkpointEvery = 0;         // Output/Checkpoint Every: steps between checkpoints, 0 = none
+  // Valid but suspicious input (e.g. a capstan that can never touch its faces):
+  // printed by the driver, the run goes on.
+  std::vector<std::string> warnings;
   Teuchos::ParameterList resolved; // the whole scene with defaults filled in
 };
 
@@ -58,5 +63,11 @@ Teuchos::ParameterList validParameters();
 // file and the parameter path.
 Scene loadScene(const std::string& file, const std::vector<std::string>& sets,
                 const std::string& outputOverride);
+
+// loadScene on the file's content (named `file` in messages): the parse and
+// validation the driver runs, without the file (fuzz/scene_fuzz.cpp). Any input
+// gives a Scene or an InputError.
+Scene parseScene(const std::string& content, const std::string& file, const std::vector<std::string>& sets,
+                 const std::string& outputOverride);
 
 }  // namespace capstan

@@ -3,6 +3,7 @@
 #include <Teuchos_CommHelpers.hpp>
 #include <Teuchos_DefaultMpiComm.hpp>
 
+#include <charconv>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -13,6 +14,7 @@
 
 #include "anderson.hpp"
 #include "assembly.hpp"
+#include "checkpoint.hpp"
 #include "errors.hpp"
 #include "field_writer.hpp"
 #include "json.hpp"
@@ -70,11 +72,72 @@ struct StateFigures {
 void writeAtomically(const fs::path& path, const std::string& text) {
   const fs::path tmp = path.string() + ".tmp";
   {
-    std::ofstream out(tmp);
+    std::ofstream out(tmp, std::ios::binary);
     out << text;
     if (!out) throw std::runtime_error("cannot write " + tmp.string());
   }
   fs::rename(tmp, path);
+}
+
+// The lowest rank with a non-empty `error`, or -1 when no rank has one;
+// `error` then holds that rank's message on every rank.
+int firstError(const Comm& comm, std::string& error) {
+  const int size = comm.getSize();
+  int mine = error.empty() ? size : comm.getRank(), first = size;
+  Teuchos::reduceAll(comm, Teuchos::REDUCE_MIN, mine, Teuchos::outArg(first));
+  if (first == size) return -1;
+  int length = int(error.size());
+  Teuchos::broadcast(comm, first, &length);
+  error.resize(size_t(length));
+  if (length > 0) Teuchos::broadcast(comm, first, length, &error[0]);
+  return first;
+}
+
+// Collective error checks: every rank throws together, so none is left
+// waiting in a collective call.
+void agreeInput(const Comm& comm, std::string error) {
+  if (firstError(comm, error) >= 0) throw InputError(error);
+}
+void agreeRuntime(const Comm& comm, std::string error) {
+  if (firstError(comm, error) >= 0) throw std::runtime_error(error);
+}
+
+// Step records in a checkpoint (rank 0's file): what summary.json and
+// history.csv list for the steps before the restart.
+void putRecord(checkpoint::Writer& w, const StepRecord& r) {
+  w.put(r.step), w.put(r.time), w.put(r.newton), w.put(r.linear), w.put(r.cutbacks);
+  w.put(r.augmentations), w.put(r.residual), w.put(r.wall), w.put(r.volumeChange);
+  w.put<int>(int(r.supports.size()));
+  for (const auto& s : r.supports) w.put(s.first), w.put(s.second);
+  w.put<int>(int(r.capstans.size()));
+  for (const auto& c : r.capstans) {
+    w.put(c.name), w.put(c.force), w.put(c.torque), w.put(c.maxPenetration), w.put(c.peakPressure);
+    w.put(c.area), w.put(c.width), w.put(c.points), w.put(c.friction), w.put(c.stick), w.put(c.slip);
+    w.put(c.frictionIntegral), w.put(c.normalIntegral), w.put(c.maxFrictionRatio);
+  }
+}
+
+StepRecord getRecord(checkpoint::Reader& in) {
+  StepRecord r;
+  r.step = in.get<int>(), r.time = in.get<double>(), r.newton = in.get<int>();
+  r.linear = in.get<int>(), r.cutbacks = in.get<int>(), r.augmentations = in.get<int>();
+  r.residual = in.get<double>(), r.wall = in.get<double>(), r.volumeChange = in.get<double>();
+  const int ns = in.get<int>();
+  for (int i = 0; i < ns; ++i) {
+    auto name = in.getString();
+    r.supports.push_back({name, in.get<std::array<double, 3>>()});
+  }
+  const int nc = in.get<int>();
+  for (int i = 0; i < nc; ++i) {
+    CapstanRecord c;
+    c.name = in.getString(), c.force = in.get<std::array<double, 3>>(), c.torque = in.get<double>();
+    c.maxPenetration = in.get<double>(), c.peakPressure = in.get<double>(), c.area = in.get<double>();
+    c.width = in.get<double>(), c.points = in.get<long>(), c.friction = in.get<bool>();
+    c.stick = in.get<long>(), c.slip = in.get<long>(), c.frictionIntegral = in.get<double>();
+    c.normalIntegral = in.get<double>(), c.maxFrictionRatio = in.get<double>();
+    r.capstans.push_back(c);
+  }
+  return r;
 }
 
 class Run {
@@ -117,6 +180,32 @@ class Run {
   void writeFields(int step, double time);
   void writeSummary(bool converged, const std::string& failure);
   void writeHistory();
+  void checkOutputDirectory();
+  // fields.h5 rows of this rank (collective).
+  FieldLayout fieldLayout() const;
+
+  // Checkpoint/restart. The state a continuation needs: u, every effect's
+  // multipliers (pressure anchors, contact and tangential multipliers) and
+  // history (friction's positions, tractions and stick states), the step and
+  // its time, and the step records for summary.json and history.csv. The step
+  // size needs no saving: every step starts at the full Time/Step Size (cuts
+  // last only within a step), and nothing else carries over between steps
+  // (each Newton solve, Anderson mixing and preconditioner is built afresh).
+  struct Restart {
+    fs::path dir;  // the checkpoint read (OUTDIR/checkpoint/step-N)
+    fs::path file; // this rank's file in it
+    int step = 0;
+    double time = 0;
+    std::unique_ptr<checkpoint::Reader> in;  // positioned after the header
+  };
+  std::string checkpointBytes(int step, double time) const;
+  void writeCheckpoint(int step, double time);
+  // Finds and checks the checkpoint against the scene before anything is built.
+  void openRestart(Restart& r);
+  // Loads the state into the built run; throws InputError where it does not fit.
+  void restore(Restart& r);
+  // Node ids of each entity of effect e (nodes per entity in `perEntity`).
+  std::vector<long long> entityKeys(const Effect& e, int& perEntity) const;
 
   const Scene& scene_;
   RCP<const Comm> comm_;
@@ -132,6 +221,9 @@ class Run {
   std::vector<StepRecord> steps_;
   fs::path dir_;
   double outputSeconds_ = 0;
+  // A restarted run's summary adds the earlier run's time and kernel counts.
+  double timingOffset_[4] = {0, 0, 0, 0};  // total, assembly, linear solve, output
+  std::map<std::string, std::pair<long, double>> effectOffset_;
   long numContactFaces_ = 0;  // global, each candidate face once
   double absTolerance_ = 0;
   double forceScale_ = 1;  // c L^2, L the body's largest extent
@@ -610,15 +702,17 @@ void Run::writeSummary(bool converged, const std::string& failure) {
       .add("max_displacement", vec(s.maxDisplacement))
       .add("node_displacement_mean", faces.str());
   Object effects;
-  for (const auto& e : assembly_->effects())
-    effects.add(e->name(), Object().add("launches", json::number(e->launches()))
-                               .add("seconds", json::number(e->seconds())).str());
-  const double total = since(t0_);
+  for (const auto& e : assembly_->effects()) {
+    const auto offset = effectOffset_[e->name()];
+    effects.add(e->name(), Object().add("launches", json::number(e->launches() + offset.first))
+                               .add("seconds", json::number(e->seconds() + offset.second)).str());
+  }
+  const double total = since(t0_) + timingOffset_[0];
   Object timing;
   timing.add("total", json::number(total))
-      .add("assembly", json::number(assembly_->assemblySeconds()))
-      .add("linear_solve", json::number(newton_->linearSolveSeconds()))
-      .add("output", json::number(outputSeconds_));
+      .add("assembly", json::number(assembly_->assemblySeconds() + timingOffset_[1]))
+      .add("linear_solve", json::number(newton_->linearSolveSeconds() + timingOffset_[2]))
+      .add("output", json::number(outputSeconds_ + timingOffset_[3]));
   Object mesh;
   mesh.add("nodes", json::number(long(mesh_.numGlobalNodes)))
       .add("elements", json::number(long(mesh_.numGlobalElements)))
@@ -635,8 +729,7 @@ void Run::writeSummary(bool converged, const std::string& failure) {
   writeAtomically(dir_ / "summary.json", top.str() + "\n");
 }
 
-int Run::execute() {
-  // Output directory: checked before any work, so bad input writes nothing.
+void Run::checkOutputDirectory() {
   dir_ = scene_.outputDirectory;
   int dirOk = 1;
   std::string dirError;
@@ -657,12 +750,303 @@ int Run::execute() {
   if (!dirOk)
     throw InputError(scene_.file + ": parameter 'Output/Directory': cannot write to '" +
                      dir_.string() + "'" + (dirError.empty() ? "" : ": " + dirError));
+}
 
+FieldLayout Run::fieldLayout() const {
+  FieldLayout layout;
+  layout.comm = rawComm(comm_);
+  long long nodes = (long long)mesh_.numOwnedNodes, elems = (long long)mesh_.numElements();
+  MPI_Exscan(&nodes, &layout.nodeOffset, 1, MPI_LONG_LONG, MPI_SUM, layout.comm);
+  MPI_Exscan(&elems, &layout.elemOffset, 1, MPI_LONG_LONG, MPI_SUM, layout.comm);
+  if (comm_->getRank() == 0) layout.nodeOffset = layout.elemOffset = 0;
+  layout.nodesOwned = nodes;
+  layout.elemsOwned = elems;
+  layout.nodesGlobal = mesh_.numGlobalNodes;
+  layout.elemsGlobal = mesh_.numGlobalElements;
+  // File index of every overlapped node: owners tell the ranks that share it.
+  Tpetra::Vector<> fileId(mesh_.ownedNodeMap), fileIdOverlap(mesh_.overlapNodeMap);
+  {
+    auto d = fileId.getDataNonConst();
+    for (size_t n = 0; n < mesh_.numOwnedNodes; ++n) d[n] = double(layout.nodeOffset + (long long)n);
+  }
+  fileIdOverlap.doImport(fileId, Tpetra::Import<>(mesh_.ownedNodeMap, mesh_.overlapNodeMap), Tpetra::INSERT);
+  auto ids = fileIdOverlap.getData();
+  for (int n : mesh_.connectivity) layout.hexConnectivity.push_back((long long)ids[n]);
+  // Contact-face grid: the union of the capstans' candidate faces.
+  long long faces = (long long)(assembly_->contactFaceNodes().size() / 4);
+  MPI_Exscan(&faces, &layout.faceOffset, 1, MPI_LONG_LONG, MPI_SUM, layout.comm);
+  if (comm_->getRank() == 0) layout.faceOffset = 0;
+  layout.facesOwned = faces;
+  layout.facesGlobal = numContactFaces_;
+  for (int n : assembly_->contactFaceNodes()) layout.quadConnectivity.push_back((long long)ids[n]);
+  return layout;
+}
+
+std::vector<long long> Run::entityKeys(const Effect& e, int& perEntity) const {
+  auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), e.local().dofs);
+  perEntity = int(dofs.extent(1) / 3);
+  std::vector<long long> keys(dofs.extent(0) * perEntity);
+  for (size_t i = 0; i < dofs.extent(0); ++i)
+    for (int a = 0; a < perEntity; ++a) keys[i * perEntity + a] = mesh_.nodeGids[dofs(i, 3 * a) / 3];
+  return keys;
+}
+
+namespace {
+std::vector<double> hostValues(const Kokkos::View<double*>& v) {
+  auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), v);
+  return std::vector<double>(h.data(), h.data() + h.size());
+}
+}  // namespace
+
+std::string Run::checkpointBytes(int step, double time) const {
+  checkpoint::Writer w;
+  w.put(std::string(checkpoint::kMagic));
+  w.put<int>(comm_->getSize()), w.put<int>(comm_->getRank());
+  w.put<int>(step), w.put<double>(time), w.put<double>(scene_.stepSize);
+  w.put(scene_.mesh.min), w.put(scene_.mesh.max), w.put(scene_.mesh.cells);
+  // Displacement of the owned nodes, by node id.
+  std::vector<long long> gids(mesh_.nodeGids.begin(), mesh_.nodeGids.begin() + mesh_.numOwnedNodes);
+  auto ud = u_->getData();
+  w.put(gids);
+  w.put(std::vector<double>(ud.begin(), ud.end()));
+  // Every effect's multipliers and history, by its entities' node ids.
+  const auto& effects = assembly_->effects();
+  w.put<int>(int(effects.size()));
+  for (const auto& e : effects) {
+    int perEntity = 0;
+    const auto keys = entityKeys(*e, perEntity);
+    w.put(e->name()), w.put<int>(perEntity), w.put(keys);
+    w.put(hostValues(e->multipliers()));
+    w.put(hostValues(e->history()));
+  }
+  // Rank 0: the step records, and what the summary adds up over the runs.
+  if (rank0_) {
+    w.put<int>(int(steps_.size()));
+    for (const auto& r : steps_) putRecord(w, r);
+    w.put<double>(since(t0_) + timingOffset_[0]);
+    w.put<double>(assembly_->assemblySeconds() + timingOffset_[1]);
+    w.put<double>(newton_->linearSolveSeconds() + timingOffset_[2]);
+    w.put<double>(outputSeconds_ + timingOffset_[3]);
+    for (const auto& e : effects) {
+      const auto offset = effectOffset_.count(e->name()) ? effectOffset_.at(e->name()) : std::pair<long, double>{};
+      w.put<long>(e->launches() + offset.first), w.put<double>(e->seconds() + offset.second);
+    }
+  }
+  return w.bytes();
+}
+
+void Run::writeCheckpoint(int step, double time) {
+  const auto t = Clock::now();
+  const fs::path root = dir_ / "checkpoint";
+  const std::string name = checkpoint::stepName(step);
+  const fs::path done = root / name, tmp = root / (name + ".tmp");
+  std::string error;
+  if (rank0_) {
+    try {
+      fs::remove_all(tmp);
+      fs::create_directories(tmp);
+    } catch (const std::exception& e) {
+      error = std::string("checkpoint: ") + e.what();
+    }
+  }
+  agreeRuntime(*comm_, error);
+  try {
+    writeAtomically(tmp / checkpoint::rankFile(comm_->getRank()), checkpointBytes(step, time));
+  } catch (const std::exception& e) {
+    error = std::string("checkpoint: ") + e.what();
+  }
+  agreeRuntime(*comm_, error);
+  // Every rank's file is there: the rename publishes the checkpoint at once,
+  // then the older ones go (a restart takes the newest complete one).
+  if (rank0_) {
+    try {
+      fs::remove_all(done);
+      fs::rename(tmp, done);
+      for (const auto& entry : fs::directory_iterator(root))
+        if (entry.path() != done) fs::remove_all(entry.path());
+    } catch (const std::exception& e) {
+      error = std::string("checkpoint: ") + e.what();
+    }
+  }
+  agreeRuntime(*comm_, error);
+  outputSeconds_ += since(t);
+}
+
+void Run::openRestart(Restart& r) {
+  const std::string where = scene_.file + ": --restart " + opt_.restart + ": ";
+  // Rank 0 picks the checkpoint, so every rank reads the same one.
+  std::string dir, error;
+  int files = 0;
+  if (rank0_) {
+    const fs::path found = checkpoint::latest(fs::path(opt_.restart) / "checkpoint");
+    if (found.empty()) {
+      error = where + "no checkpoint in '" + (fs::path(opt_.restart) / "checkpoint").string() +
+              "' (an earlier run of the scene with Output/Checkpoint Every > 0 writes them)";
+    } else {
+      dir = found.string();
+      while (fs::exists(found / checkpoint::rankFile(files))) ++files;
+    }
+  }
+  agreeInput(*comm_, error);
+  int length = int(dir.size());
+  Teuchos::broadcast(*comm_, 0, &length);
+  dir.resize(size_t(length));
+  Teuchos::broadcast(*comm_, 0, length, &dir[0]);
+  Teuchos::broadcast(*comm_, 0, &files);
+  if (files != comm_->getSize())
+    throw InputError(where + "the checkpoint '" + dir + "' was written on " + std::to_string(files) +
+                     " rank(s); restart it on as many (mpiexec -n " + std::to_string(files) + ")");
+  r.dir = dir;
+  r.file = r.dir / checkpoint::rankFile(comm_->getRank());
+  try {
+    std::ifstream in(r.file, std::ios::binary);
+    if (!in) throw std::runtime_error("cannot read it");
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    r.in = std::make_unique<checkpoint::Reader>(std::move(bytes));
+    auto& rd = *r.in;
+    if (rd.getString() != checkpoint::kMagic) throw std::runtime_error("not a capstan checkpoint");
+    const int ranks = rd.get<int>(), rank = rd.get<int>();
+    if (ranks != comm_->getSize() || rank != comm_->getRank())
+      throw std::runtime_error("written by rank " + std::to_string(rank) + " of " + std::to_string(ranks));
+    r.step = rd.get<int>();
+    r.time = rd.get<double>();
+    const double dt = rd.get<double>();
+    const auto min = rd.get<std::array<double, 3>>(), max = rd.get<std::array<double, 3>>();
+    const auto cells = rd.get<std::array<int, 3>>();
+    auto shortest = [](double x) {  // 0.01, not 1.00000000000000002e-02
+      char buf[32];
+      return std::string(buf, std::to_chars(buf, buf + sizeof buf, x).ptr);
+    };
+    auto text = [&](const auto& a) {
+      return "{" + shortest(a[0]) + ", " + shortest(a[1]) + ", " + shortest(a[2]) + "}";
+    };
+    if (cells != scene_.mesh.cells)
+      error = "parameter 'Mesh/Cells': the scene has " + text(scene_.mesh.cells) + ", the checkpoint's mesh " +
+              text(cells) + " (a different mesh size)";
+    else if (min != scene_.mesh.min || max != scene_.mesh.max)
+      error = "parameter 'Mesh/Min', 'Mesh/Max': the scene has " + text(scene_.mesh.min) + " to " +
+              text(scene_.mesh.max) + ", the checkpoint " + text(min) + " to " + text(max);
+    else if (dt != scene_.stepSize)
+      error = "parameter 'Time/Step Size': the scene has " + shortest(scene_.stepSize) +
+              ", the checkpoint " + shortest(dt);
+    else if (r.step > scene_.steps)
+      error = "parameter 'Time/Steps': the scene has " + std::to_string(scene_.steps) +
+              " steps, the checkpoint is of step " + std::to_string(r.step);
+  } catch (const std::exception& e) {
+    error = r.file.string() + ": " + e.what();
+  }
+  agreeInput(*comm_, error.empty() ? "" : where + error);
+}
+
+void Run::restore(Restart& r) {
+  std::string error;
+  try {
+    auto& in = *r.in;
+    // Displacement: every owned node's value, found by node id.
+    const auto gids = in.getVector<long long>();
+    const auto u = in.getVector<double>();
+    if (gids.size() != mesh_.numOwnedNodes || u.size() != 3 * gids.size())
+      throw std::runtime_error("holds " + std::to_string(gids.size()) + " nodes, this rank owns " +
+                               std::to_string(mesh_.numOwnedNodes) + " (another mesh or partition)");
+    std::map<long long, size_t> owned;
+    for (size_t n = 0; n < mesh_.numOwnedNodes; ++n) owned[mesh_.nodeGids[n]] = n;
+    auto ud = u_->getDataNonConst();
+    for (size_t i = 0; i < gids.size(); ++i) {
+      const auto it = owned.find(gids[i]);
+      if (it == owned.end()) throw std::runtime_error("node " + std::to_string(gids[i]) + " is not owned here");
+      for (int c = 0; c < 3; ++c) ud[3 * it->second + c] = u[3 * i + c];
+    }
+    // Effects: the same ones, each value put back on its entity by node ids.
+    const auto& effects = assembly_->effects();
+    std::string have, want;
+    for (const auto& e : effects) want += (want.empty() ? "" : ", ") + e->name();
+    const int count = in.get<int>();
+    std::vector<std::string> names;
+    struct Saved {
+      int perEntity;
+      std::vector<long long> keys;
+      std::vector<double> multipliers, history;
+    };
+    std::vector<Saved> saved;
+    for (int i = 0; i < count; ++i) {
+      names.push_back(in.getString());
+      have += (have.empty() ? "" : ", ") + names.back();
+      Saved sv;
+      sv.perEntity = in.get<int>();
+      sv.keys = in.getVector<long long>();
+      sv.multipliers = in.getVector<double>();
+      sv.history = in.getVector<double>();
+      saved.push_back(std::move(sv));
+    }
+    if (have != want)
+      throw std::runtime_error("holds the effects [" + have + "], the scene runs [" + want +
+                               "] (a different set of supports, capstans or friction laws)");
+    for (size_t i = 0; i < effects.size(); ++i) {
+      auto& e = *effects[i];
+      const auto& sv = saved[i];
+      int perEntity = 0;
+      const auto keys = entityKeys(e, perEntity);
+      const size_t entities = perEntity ? keys.size() / perEntity : 0;
+      if (perEntity != sv.perEntity || keys.size() != sv.keys.size())
+        throw std::runtime_error(e.name() + ": " + std::to_string(sv.keys.size() / std::max(sv.perEntity, 1)) +
+                                 " entities, the scene has " + std::to_string(entities));
+      std::map<std::vector<long long>, size_t> index;
+      for (size_t k = 0; k < entities; ++k)
+        index[std::vector<long long>(keys.begin() + k * perEntity, keys.begin() + (k + 1) * perEntity)] = k;
+      auto put = [&](Kokkos::View<double*> view, const std::vector<double>& values, const char* what) {
+        if (values.size() != view.size())
+          throw std::runtime_error(e.name() + ": " + std::to_string(values.size()) + " " + what + ", the scene has " +
+                                   std::to_string(view.size()));
+        if (view.size() == 0) return;
+        const size_t per = view.size() / entities;
+        auto h = Kokkos::create_mirror_view(view);
+        for (size_t k = 0; k < entities; ++k) {
+          const auto it = index.find(
+              std::vector<long long>(sv.keys.begin() + k * perEntity, sv.keys.begin() + (k + 1) * perEntity));
+          if (it == index.end()) throw std::runtime_error(e.name() + ": an entity the scene does not have");
+          for (size_t j = 0; j < per; ++j) h(it->second * per + j) = values[k * per + j];
+        }
+        Kokkos::deep_copy(view, h);
+      };
+      put(e.multipliers(), sv.multipliers, "multipliers");
+      put(e.history(), sv.history, "history values");
+    }
+    if (rank0_) {
+      const int n = in.get<int>();
+      for (int i = 0; i < n; ++i) steps_.push_back(getRecord(in));
+      for (double& t : timingOffset_) t = in.get<double>();
+      for (const auto& e : effects) {
+        const long launches = in.get<long>();
+        effectOffset_[e->name()] = {launches, in.get<double>()};
+      }
+    }
+    if (!in.atEnd()) throw std::runtime_error("damaged (data after the end)");
+  } catch (const std::exception& e) {
+    error = scene_.file + ": --restart " + opt_.restart + ": " + r.file.string() + ": " + e.what();
+  }
+  agreeInput(*comm_, error);
+}
+
+int Run::execute() {
+  // Everything that can be wrong with the input is found before anything is
+  // written: the ranks, the checkpoint of a restart, then the output directory.
   const auto& m = scene_.mesh;
+  const double elements = double(m.cells[0]) * m.cells[1] * m.cells[2];
+  if (elements < comm_->getSize())
+    throw InputError(scene_.file + ": parameter 'Mesh/Cells': " + Teuchos::toString(elements) +
+                     " element(s) for " + std::to_string(comm_->getSize()) +
+                     " MPI ranks; every rank needs at least one");
+  Restart restart;
+  if (!opt_.restart.empty()) openRestart(restart);
+
   generator_ = std::make_unique<BoxGenerator>(m.min, m.max, m.cells);
   mesh_ = distributeMesh(*generator_, comm_);
   assembly_ = std::make_unique<Assembly>(mesh_, scene_);
-  newton_ = std::make_unique<NewtonSolver>(*assembly_, scene_.solver);
+  try {
+    newton_ = std::make_unique<NewtonSolver>(*assembly_, scene_.solver);
+  } catch (const InputError& e) {  // the Solver/NOX or Solver/Stratimikos sublist
+    throw InputError(scene_.file + ": " + e.what());
+  }
   u_ = rcp(new Vector(mesh_.ownedDofMap));
   double size2 = 0;
   for (int d = 0; d < 3; ++d) size2 = std::max(size2, std::pow(m.max[d] - m.min[d], 2));
@@ -672,45 +1056,68 @@ int Run::execute() {
   long localFaces = long(assembly_->contactFaceNodes().size() / 4);
   Teuchos::reduceAll(*comm_, Teuchos::REDUCE_SUM, localFaces, Teuchos::outArg(numContactFaces_));
 
-  if (scene_.writeFields) {
-    FieldLayout layout;
-    layout.comm = rawComm(comm_);
-    long long nodes = (long long)mesh_.numOwnedNodes, elems = (long long)mesh_.numElements();
-    MPI_Exscan(&nodes, &layout.nodeOffset, 1, MPI_LONG_LONG, MPI_SUM, layout.comm);
-    MPI_Exscan(&elems, &layout.elemOffset, 1, MPI_LONG_LONG, MPI_SUM, layout.comm);
-    if (comm_->getRank() == 0) layout.nodeOffset = layout.elemOffset = 0;
-    layout.nodesOwned = nodes;
-    layout.elemsOwned = elems;
-    layout.nodesGlobal = mesh_.numGlobalNodes;
-    layout.elemsGlobal = mesh_.numGlobalElements;
-    // File index of every overlapped node: owners tell the ranks that share it.
-    Tpetra::Vector<> fileId(mesh_.ownedNodeMap), fileIdOverlap(mesh_.overlapNodeMap);
-    {
-      auto d = fileId.getDataNonConst();
-      for (size_t n = 0; n < mesh_.numOwnedNodes; ++n) d[n] = double(layout.nodeOffset + (long long)n);
-    }
-    fileIdOverlap.doImport(fileId, Tpetra::Import<>(mesh_.ownedNodeMap, mesh_.overlapNodeMap), Tpetra::INSERT);
-    auto ids = fileIdOverlap.getData();
-    for (int n : mesh_.connectivity) layout.hexConnectivity.push_back((long long)ids[n]);
-    // Contact-face grid: the union of the capstans' candidate faces.
-    long long faces = localFaces;
-    MPI_Exscan(&faces, &layout.faceOffset, 1, MPI_LONG_LONG, MPI_SUM, layout.comm);
-    if (comm_->getRank() == 0) layout.faceOffset = 0;
-    layout.facesOwned = faces;
-    layout.facesGlobal = numContactFaces_;
-    for (int n : assembly_->contactFaceNodes()) layout.quadConnectivity.push_back((long long)ids[n]);
-    writer_ = std::make_unique<FieldWriter>(dir_.string(), layout);
+  if (restart.in) {
+    restore(restart);
+    // fields.h5 is continued: the earlier run's must be there to append to.
+    int found = 1;
+    if (rank0_ && scene_.writeFields) found = fs::exists(fs::path(opt_.restart) / "fields.h5") ? 1 : 0;
+    Teuchos::broadcast(*comm_, 0, &found);
+    if (!found)
+      throw InputError(scene_.file + ": --restart " + opt_.restart + ": no fields.h5 there to continue "
+                       "(the earlier run had Output/Write Fields = false?)");
+  }
+
+  checkOutputDirectory();
+  // Checkpoints of an earlier run into this directory do not belong to this
+  // one (a restart keeps the one it started from until it writes its own).
+  if (rank0_) {
+    std::error_code ec;
+    for (fs::directory_iterator it(dir_ / "checkpoint", ec), end; !ec && it != end; it.increment(ec))
+      if (!restart.in || !fs::equivalent(it->path(), restart.dir, ec)) fs::remove_all(it->path(), ec);
   }
 
   const int N = scene_.steps;
   const double dt = scene_.stepSize;
-  assembly_->setInterval(0, 0);
-  assembly_->evaluate(*u_, nullptr, nullptr);
-  writeFields(0, 0.0);
+  int firstStep = 1;
   double tDone = 0;
+  if (restart.in) {
+    firstStep = restart.step + 1;
+    tDone = restart.time;
+    if (scene_.writeFields) {
+      // Continue the earlier run's fields.h5 (a copy, when this run writes elsewhere).
+      std::string error;
+      if (rank0_) {
+        std::error_code ec;
+        const fs::path from = fs::path(opt_.restart) / "fields.h5", to = dir_ / "fields.h5";
+        if (!fs::equivalent(from, to, ec)) fs::copy_file(from, to, fs::copy_options::overwrite_existing, ec);
+        if (ec) error = "cannot copy " + from.string() + " to " + to.string() + ": " + ec.message();
+      }
+      agreeRuntime(*comm_, error);
+    }
+    if (!opt_.quiet && rank0_) {
+      std::printf("restart from %s: step %d, t=%.4g\n", restart.dir.string().c_str(), restart.step, tDone);
+      std::fflush(stdout);
+    }
+  }
+  if (scene_.writeFields) {
+    if (restart.in) {
+      const FieldLayout layout = fieldLayout();
+      try {
+        writer_ = std::make_unique<FieldWriter>(dir_.string(), layout, FieldWriter::Append{restart.step});
+      } catch (const std::exception& e) {
+        throw InputError(scene_.file + ": --restart " + opt_.restart + ": cannot continue fields.h5: " + e.what());
+      }
+    } else {
+      writer_ = std::make_unique<FieldWriter>(dir_.string(), fieldLayout());
+    }
+  }
+
+  assembly_->setInterval(tDone, tDone);
+  assembly_->evaluate(*u_, nullptr, nullptr);
+  if (!restart.in) writeFields(0, 0.0);
   std::string failure;
   bool ok = true;
-  for (int step = 1; step <= N && ok; ++step) {
+  for (int step = firstStep; step <= N && ok; ++step) {
     const auto tStep = Clock::now();
     StepRecord rec;
     rec.step = step;
@@ -766,10 +1173,11 @@ int Run::execute() {
     writeFields(step, rec.time);
     for (const auto& e : assembly_->effects()) e->commit(assembly_->positions());
     writeHistory();
+    if (scene_.checkpointEvery > 0 && step % scene_.checkpointEvery == 0) writeCheckpoint(step, tDone);
     if (!opt_.quiet && rank0_) {
       std::printf("step %d/%d  t=%.4g  newton=%d  linear=%d  |R|=%.3e  dV=%.1e  max_penetration=%.3e  %.2fs\n",
                   step, N, rec.time, rec.newton, rec.linear, rec.residual, rec.volumeChange,
-                  rec.maxPenetration(), since(t0_));
+                  rec.maxPenetration(), since(t0_) + timingOffset_[0]);
       std::fflush(stdout);
     }
   }

@@ -223,6 +223,66 @@ TEST(FieldWriter, BadArgumentThrowsOnAllRanks) {
   removeDir(dir);
 }
 
+// Restart: steps 0 and 7 written, then 8 (as if written after a checkpoint of
+// step 7 and then killed); appending after 7 drops 8, keeps 0 and 7 and their
+// index, and the next steps follow. A file of another mesh is refused.
+TEST(FieldWriter, AppendAfterCheckpoint) {
+  const std::string dir = makeTempDir();
+  writeSteps(dir, true);
+  const capstan::FieldLayout l = layout(true);
+  auto coords = [&](int step) {
+    std::vector<double> c;
+    for (long long n = l.nodeOffset; n < l.nodeOffset + l.nodesOwned; ++n)
+      for (int k = 0; k < 3; ++k) c.push_back(coordinate(step, n, k));
+    return c;
+  };
+  auto nodal = [&](int step) {
+    return std::vector<capstan::Field>{field("displacement", 0, 3, step, l.nodeOffset, l.nodesOwned)};
+  };
+  {
+    capstan::FieldWriter writer(dir, l, capstan::FieldWriter::Append{7});
+    writer.writeStep(8, 4.0, coords(99), nodal(99), {}, {});  // the step a restart redoes
+  }
+  {
+    capstan::FieldWriter writer(dir, l, capstan::FieldWriter::Append{7});
+    writer.writeStep(8, 4.0, coords(8), nodal(8), {}, {});
+    writer.writeStep(9, 4.5, coords(9), nodal(9), {}, {});
+  }
+  EXPECT_EQ(H5Fget_obj_count(H5F_OBJ_ALL, H5F_OBJ_ALL), 0);
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (rank() == 0) {
+    checkFile(dir, true);  // steps 0 and 7 as first written
+    hid_t file = H5Fopen((dir + "/fields.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+    ASSERT_GE(file, 0);
+    hsize_t n = 0;
+    hid_t steps = H5Gopen2(file, "/steps", H5P_DEFAULT);
+    H5G_info_t info;
+    H5Gget_info(steps, &info);
+    n = info.nlinks;
+    H5Gclose(steps);
+    EXPECT_EQ(n, 4u);  // 0, 7, 8, 9: the first step 8 is gone
+    for (int step : {8, 9}) {
+      char g[40];
+      std::snprintf(g, sizeof g, "/steps/%06d/nodes/displacement", step);
+      expectField(file, g, 0, step, 12, 3);
+    }
+    H5Fclose(file);
+    std::ifstream in(dir + "/fields.xmf");
+    std::stringstream xmf;
+    xmf << in.rdbuf();
+    const std::string text = xmf.str();
+    size_t grids = 0;
+    for (size_t p = text.find("<Time "); p != std::string::npos; p = text.find("<Time ", p + 1)) ++grids;
+    EXPECT_EQ(grids, 4u);
+    EXPECT_NE(text.find("/steps/000007/elements/stress"), std::string::npos);  // kept step's fields indexed
+    EXPECT_NE(text.find("<Time Value=\"4.5\"/>"), std::string::npos);
+  }
+  // Another mesh (no contact faces): refused on every rank, file untouched.
+  EXPECT_THROW(capstan::FieldWriter(dir, layout(false), capstan::FieldWriter::Append{7}), std::runtime_error);
+  EXPECT_EQ(H5Fget_obj_count(H5F_OBJ_ALL, H5F_OBJ_ALL), 0);
+  removeDir(dir);
+}
+
 TEST(FieldWriter, MissingDirectoryThrows) {
   EXPECT_THROW(capstan::FieldWriter("/nonexistent/capstan_fw", layout(true)), std::runtime_error);
 }

@@ -6,6 +6,7 @@
 #include <random>
 #include <vector>
 
+#include "kernels/body_force.hpp"
 #include "kernels/brick.hpp"
 #include "kernels/foundation.hpp"
 
@@ -182,6 +183,38 @@ TEST(Foundation, TangentMatchesCentralDifferences) {
   EXPECT_NEAR(F[0], 2.5 * 0.2 * area, 1e-12);
   EXPECT_NEAR(F[1], 0.0, 1e-15);
   EXPECT_NEAR(F[2], 2.5 * -0.1 * area, 1e-12);
+}
+
+// Body force: a dead load, so there is no tangent (the residual does not depend on
+// the motion: nothing to difference). Its nodal loads add up to b V, and on a
+// parallelepiped each node carries V / 8 (int N_a dV exact with 2x2x2 Gauss).
+TEST(BodyForce, LoadsAddUpToBTimesVolume) {
+  double X[8][3];
+  distortedBrick(X, 7);
+  const double b[3] = {0.3, -1.7, 0.25};
+  double R[24];
+  brickBodyForce(X, b, R);
+  double V = 0;
+  for (int q = 0; q < 8; ++q) {
+    double D[8][3];
+    V += hexReferenceGradients(X, gauss2(q & 1), gauss2((q >> 1) & 1), gauss2(q >> 2), D);
+  }
+  for (int i = 0; i < 3; ++i) {
+    double F = 0;
+    for (int a = 0; a < 8; ++a) F += R[3 * a + i];
+    EXPECT_NEAR(F, -b[i] * V, 1e-13 * V);
+  }
+  double P[8][3];  // a sheared box: every node carries V / 8
+  for (int a = 0; a < 8; ++a) {
+    const double s0 = 0.5 * (1 + hexXiSign(a)), s1 = 0.5 * (1 + hexEtaSign(a)), s2 = 0.5 * (1 + hexZetaSign(a));
+    P[a][0] = 2 * s0 + 0.4 * s1;
+    P[a][1] = 1.5 * s1 + 0.2 * s2;
+    P[a][2] = 0.5 * s2;
+  }
+  brickBodyForce(P, b, R);
+  const double Vp = 2 * 1.5 * 0.5;
+  for (int a = 0; a < 8; ++a)
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR(R[3 * a + i], -b[i] * Vp / 8, 1e-14);
 }
 
 }  // namespace

@@ -5,6 +5,9 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -295,6 +298,58 @@ TEST_F(SceneTest, WrongType) {
                    {"Supports/base/Face"});
 }
 
+// Numbers must read exactly as their type: Teuchos alone would keep a prefix
+// ("5.5" as the int 5) or read nothing as 0 ("abc", "nan").
+TEST_F(SceneTest, NumbersReadStrictly) {
+  const std::string c = R"X(<Parameter name="c" type="double" value="1"/>)X";
+  const std::string steps = R"X(<Parameter name="Steps"     type="int"    value="5"/>)X";
+  const std::string min = R"X(<Parameter name="Min"   type="Array(double)" value="{0, 0, 0}"/>)X";
+  for (const char* bad : {"abc", "", "nan", "inf", "1e999", "0x10", "1 2"})
+    expectInputError(write(sceneWith(c, std::string(R"X(<Parameter name="c" type="double" value=")X") + bad + "\"/>")),
+                     {"Material/c", "type double"});
+  for (const char* bad : {"5.5", "1e3", "99999999999", "five"})
+    expectInputError(write(sceneWith(steps, std::string(R"X(<Parameter name="Steps" type="int" value=")X") + bad + "\"/>")),
+                     {"Time/Steps", "type int"});
+  for (const char* bad : {"{nan, 0, 0}", "{0, 0, 0", "0, 0, 0", "{0,,0}", "{0, 0,}"})
+    expectInputError(write(sceneWith(min, std::string(R"X(<Parameter name="Min" type="Array(double)" value=")X") + bad + "\"/>")),
+                     {"Mesh/Min", "Array(double)"});
+  // Spaces around numbers are fine.
+  const Scene sc = loadScene(write(sceneWith(c, R"X(<Parameter name="c" type="double" value=" 2.5 "/>)X")), {}, "");
+  EXPECT_EQ(sc.c, 2.5);
+  expectInputError(write(sceneWith(c, R"X(<Parameter name="c" type="complex" value="1"/>)X")), {"Material/c", "complex"});
+}
+
+TEST_F(SceneTest, XmlStructure) {
+  const std::string c = R"X(<Parameter name="c" type="double" value="1"/>)X";
+  expectInputError(write(sceneWith(c, c + c)), {"Material/c", "given twice"});
+  expectInputError(write(sceneWith(R"X(<ParameterList name="Time">)X",
+                                   R"X(<ParameterList name="Time"></ParameterList><ParameterList name="Time">)X")),
+                   {"Time", "given twice"});
+  expectInputError(write(sceneWith(c, R"X(<Parameter name="c" type="double"/>)X")), {"Material/c", "value"});
+  expectInputError(write(sceneWith(c, R"X(<Parameter type="double" value="1"/>)X")), {"Material", "name"});
+  expectInputError(write(sceneWith(c, c + "<Foo/>")), {"Material", "<Foo>"});
+  // Deep nesting is refused before the recursive Teuchos reader sees it.
+  std::string deep = "<ParameterList name=\"Scene\">";
+  for (int i = 0; i < 20000; ++i) deep += "<ParameterList name=\"a\">";
+  for (int i = 0; i < 20000; ++i) deep += "</ParameterList>";
+  expectInputError(write(deep + "</ParameterList>"), {"nested deeper"});
+  expectInputError(write("<Foo name=\"Scene\"></Foo>"), {"<ParameterList>"});
+  // parseScene: the same on text, named as given.
+  EXPECT_THROW(parseScene("<ParameterList name=\"Scene\"><Parameter name=\"Titel\" type=\"string\" value=\"\"/>"
+                          "</ParameterList>", "text.xml", {}, ""),
+               InputError);
+  EXPECT_EQ(parseScene(SceneText().str(), "text.xml", {}, "").file, "text.xml");
+}
+
+TEST_F(SceneTest, MeshSizeAndFiniteValues) {
+  expectInputError(write(sceneWith(R"X(value="{4, 2, 2}")X", R"X(value="{100000, 100000, 100000}")X")),
+                   {"Mesh/Cells", "too many"});
+  expectInputError(write(SceneText().str()), {"Mesh/Min", "cannot read"}, {"Mesh/Min={0, 1e999, 0}"});
+  expectInputError(write(SceneText().str()), {"Output/Checkpoint Every"}, {"Output/Checkpoint Every=-1"});
+  EXPECT_EQ(loadScene(write(SceneText().str()), {"Output/Checkpoint Every=3"}, "").checkpointEvery, 3);
+  EXPECT_EQ(loadScene(write(SceneText().str()), {}, "").checkpointEvery, 0);
+}
+
 // ---------------------------------------------------------------------------
 // Values
 
@@ -405,6 +460,36 @@ TEST_F(SceneTest, SetOverrides) {
   // Other values untouched.
   EXPECT_EQ(s.pressurePenalty, 1e-3);
   EXPECT_EQ(s.mesh.max, (std::array<double, 3>{2, 1, 1}));
+}
+
+TEST_F(SceneTest, AccuracyPresets) {
+  const std::string file = write(SceneText().str());
+  const std::array<int, 3> cells = loadScene(file, {}, "").mesh.cells;
+  const Scene scene = loadScene(file, {"Accuracy=Scene"}, "");
+  EXPECT_EQ(scene.mesh.cells, cells);
+  EXPECT_EQ(scene.solver.get<double>("Newton Relative Tolerance"), 1e-10);
+  const Scene draft = loadScene(file, {"Accuracy=Draft"}, "");
+  EXPECT_EQ(draft.mesh.cells, cells);
+  EXPECT_EQ(draft.solver.get<double>("Newton Relative Tolerance"), 1e-6);
+  // A tolerance the scene sets itself wins over the preset.
+  const Scene draftOwn = loadScene(file, {"Accuracy=Draft", "Solver/Newton Relative Tolerance=1e-9"}, "");
+  EXPECT_EQ(draftOwn.solver.get<double>("Newton Relative Tolerance"), 1e-9);
+  const Scene standard = loadScene(file, {"Accuracy=Standard"}, "");
+  const Scene fine = loadScene(file, {"Accuracy=Fine"}, "");
+  for (int d = 0; d < 3; ++d) {
+    EXPECT_EQ(standard.mesh.cells[d], 2 * cells[d]);
+    EXPECT_EQ(fine.mesh.cells[d], 4 * cells[d]);
+  }
+  EXPECT_EQ(fine.resolved.get<std::string>("Accuracy"), "Fine");
+  expectInputError(file, {"'Accuracy'", "'Coarse' is not an accuracy preset"}, {"Accuracy=Coarse"});
+}
+
+TEST_F(SceneTest, BodyForce) {
+  const std::string file = write(SceneText().str());
+  EXPECT_EQ(loadScene(file, {}, "").bodyForce, (std::array<double, 3>{0, 0, 0}));
+  EXPECT_EQ(loadScene(file, {"Loads/Body Force={0, -9.81, 0}"}, "").bodyForce,
+            (std::array<double, 3>{0, -9.81, 0}));
+  expectInputError(file, {"'Loads/Body Force'", "expected 3 values"}, {"Loads/Body Force={1, 2}"});
 }
 
 TEST_F(SceneTest, SetReachesNamedObjectsAndAbsentSublists) {
@@ -527,6 +612,47 @@ TEST_F(SceneTest, CapstanInputErrors) {
   expectInputError(g1, {C + "Friction/Regularization"}, {C + "Friction/Law=Tanh", C + "Friction/Regularization=0"});
   expectInputError(g1, {"Solver/Linear Solver", "non-symmetric"},
                    {C + "Friction/Law=Coulomb", "Solver/Linear Solver=CG"});
+  expectInputError(g1, {C + "Angular Velocity", "cannot read"}, {C + "Angular Velocity=nan"});
+}
+
+// Axis directions of any scale: scaled by a power of two, so |beta|^2 neither
+// under- nor overflows, and ordinary ones keep their bits.
+TEST_F(SceneTest, AxisDirectionScale) {
+  const std::string g1 = std::string(CAPSTAN_INPUTS_DIR) + "/seed/g1.xml";
+  const std::string C = "Capstans/capstan/";
+  EXPECT_EQ(loadScene(g1, {C + "Axis Direction={0.2, 0, 1}"}, "").capstans[0].axisDirection,
+            (std::array<double, 3>{0.2, 0, 1}));
+  EXPECT_EQ(loadScene(g1, {C + "Axis Direction={0, 0, 4}"}, "").capstans[0].axisDirection,
+            (std::array<double, 3>{0, 0, 1}));
+  for (const char* d : {"{0, 0, 1e-200}", "{0, 0, 1e200}", "{1e-300, 0, 3e-300}"}) {
+    const auto b = loadScene(g1, {C + "Axis Direction=" + d}, "").capstans[0].axisDirection;
+    const double m = std::max({std::fabs(b[0]), std::fabs(b[1]), std::fabs(b[2])});
+    EXPECT_TRUE(m >= 1 && m < 2) << d << ": largest component " << m;
+  }
+}
+
+// A capstan that can never reach its faces is flagged, conservatively.
+TEST_F(SceneTest, UnreachableCapstanWarning) {
+  const std::string g1 = std::string(CAPSTAN_INPUTS_DIR) + "/seed/g1.xml";
+  const std::string C = "Capstans/capstan/";
+  EXPECT_TRUE(loadScene(g1, {}, "").warnings.empty());
+  const auto far = loadScene(g1, {C + "Axis Point={3.5, 100, 0}"}, "");
+  ASSERT_EQ(far.warnings.size(), 1u);
+  EXPECT_NE(far.warnings[0].find("Capstans/capstan"), std::string::npos) << far.warnings[0];
+  EXPECT_NE(far.warnings[0].find(g1), std::string::npos) << far.warnings[0];
+  // Body 7 x 1.75 x 4: the faces' box grows by 7; ymax at 1.75 + 7 = 8.75, so an
+  // axis at y = 10.75 + 1e-6 (R = 2) is out of reach, one at 10.7 is not.
+  EXPECT_EQ(loadScene(g1, {C + "Axis Point={3.5, 10.7501, 0}", C + "Velocity={0, 0, 0}"}, "").warnings.size(), 1u);
+  EXPECT_TRUE(loadScene(g1, {C + "Axis Point={3.5, 10.7, 0}", C + "Velocity={0, 0, 0}"}, "").warnings.empty());
+  // Moving in over the run (5 steps of 1: 50 down) reaches the body.
+  EXPECT_TRUE(loadScene(g1, {C + "Axis Point={3.5, 40, 0}", C + "Velocity={0, -10, 0}"}, "").warnings.empty());
+  // A Displacement support moving the body also counts: 5 x 2 = 10 of travel.
+  EXPECT_TRUE(loadScene(g1, {C + "Axis Point={3.5, 15, 0}", C + "Velocity={0, 0, 0}",
+                             "Supports/base/Type=Displacement", "Supports/base/Velocity={0, 2, 0}"}, "")
+                  .warnings.empty());
+  // A skewed axis far off to the side of the body in x.
+  EXPECT_EQ(loadScene(g1, {C + "Axis Point={40, 0, 0}", C + "Axis Direction={0, 1, 1}", C + "Velocity={0, 0, 0}"}, "")
+                .warnings.size(), 1u);
 }
 #endif
 

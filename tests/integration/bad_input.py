@@ -1,0 +1,236 @@
+#!/usr/bin/env python3
+"""Bad input, one case per class (interface.md: exit 1, the message names the file
+and the parameter path, nothing is written).
+
+Every case runs `capstan run` twice: into an output directory that exists and
+holds only a marker file (nothing else may appear, the marker is untouched), and
+into one that does not exist (it must not be created); the working directory
+must stay empty. Classes: wrong types, out-of-range values, wrong array lengths,
+unknown face names, a zero axis direction, Radius <= 0, malformed XML (unclosed,
+mismatched, duplicated, too deeply nested, unknown elements), an empty file,
+binary garbage, a missing scene file, an output directory under a regular file,
+bad NOX and Stratimikos sublists, a mesh with fewer cells than ranks, and bad
+--set values.
+
+Then the warning for a capstan that can never touch its contact faces: printed
+(naming the file and the capstan), the run goes on and exits 0; no warning for
+G1, nor for a capstan that starts far away but moves into the body.
+"""
+import os
+import sys
+
+sys.dont_write_bytecode = True
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from capstan_test import Test  # noqa: E402
+
+T = Test("bad_input", __doc__)
+G1 = open(T.input("seed/g1.xml")).read()
+scenes = T.path("scenes")
+work = T.path("work")
+os.makedirs(scenes)
+os.makedirs(work)
+MARKER = "marker.txt"
+counter = [0]
+
+
+def edited(*pairs):
+    text = G1
+    for old, new in pairs:
+        assert old in text, f"test bug: {old!r} not in g1.xml"
+        text = text.replace(old, new, 1)
+    return text
+
+
+def scene_file(name, content):
+    path = os.path.join(scenes, name)
+    with open(path, "wb" if isinstance(content, bytes) else "w") as f:
+        f.write(content)
+    return path
+
+
+def listing(root):
+    out = {}
+    for d, dirs, files in os.walk(root):
+        for n in dirs + files:
+            p = os.path.join(d, n)
+            out[os.path.relpath(p, root)] = os.stat(p).st_mtime_ns
+    return out
+
+
+def case(label, scene, needles, args=(), ranks=1, outdir_kinds=("existing", "missing")):
+    """Runs SCENE with ARGS into an existing (marker only) and a missing output
+    directory; expects exit 1, every needle in stderr, nothing written."""
+    for kind in outdir_kinds:
+        counter[0] += 1
+        out = T.path("out", f"{counter[0]}-{kind}")
+        if kind == "existing":
+            os.makedirs(out)
+            with open(os.path.join(out, MARKER), "w") as f:
+                f.write("marker\n")
+        before_out, before_work = (listing(out) if kind == "existing" else None), listing(work)
+        p = T.capstan_run(["run", scene, "--output", out, "--quiet"] + list(args), ranks=ranks, cwd=work)
+        tag = f"{label} ({kind} output directory{', 2 ranks' if ranks > 1 else ''})"
+        T.check(p.returncode == 1, f"{tag}: exit status {p.returncode} (1)")
+        err = p.stderr.strip()
+        first = err.splitlines()[0] if err else "(stderr empty)"
+        for n in needles:
+            T.check(n in err, f"{tag}: stderr names {n!r}: {first[:260]}")
+        if kind == "existing":
+            T.check(listing(out) == before_out, f"{tag}: output directory holds only the marker "
+                                                f"({sorted(listing(out))})")
+        else:
+            T.check(not os.path.exists(out), f"{tag}: output directory not created")
+        T.check(listing(work) == before_work, f"{tag}: working directory unchanged")
+
+
+def bad_value(label, pairs, needle):
+    f = scene_file(label.replace(" ", "_").replace("/", "_") + ".xml", edited(*pairs))
+    case(label, f, [f, needle])
+
+
+C = "Capstans/capstan"
+RADIUS = '<Parameter name="Radius"           type="double"        value="2"/>'
+AXIS = '<Parameter name="Axis Direction"   type="Array(double)" value="{0, 0, 1}"/>'
+POINT = '<Parameter name="Axis Point"       type="Array(double)" value="{3.5, 3.75, 0}"/>'
+
+# --- wrong types ------------------------------------------------------------------
+bad_value("type: string for double", [('name="c" type="double" value="1"', 'name="c" type="string" value="soft"')],
+          "Material/c")
+bad_value("type: text in a double", [('name="c" type="double" value="1"', 'name="c" type="double" value="abc"')],
+          "Material/c")
+bad_value("type: 5.5 for an int", [('type="int"    value="5"', 'type="int"    value="5.5"')], "Time/Steps")
+bad_value("type: Array(double) for Cells", [('type="Array(int)"    value="{14, 4, 6}"',
+                                             'type="Array(double)"    value="{14, 4, 6}"')], "Mesh/Cells")
+bad_value("type: bad bool", [('<Parameter name="Directory"',
+                              '<Parameter name="Write Fields" type="bool" value="maybe"/><Parameter name="Directory"')],
+          "Output/Write Fields")
+bad_value("type: unknown type", [('name="c" type="double" value="1"', 'name="c" type="complex" value="1"')],
+          "Material/c")
+bad_value("type: a parameter where a sublist belongs",
+          [('<ParameterList name="base">', '<Parameter name="x" type="int" value="1"/><ParameterList name="base">')],
+          "Supports/x")
+
+# --- out-of-range values ------------------------------------------------------------
+bad_value("range: c = -1", [('name="c" type="double" value="1"', 'name="c" type="double" value="-1"')], "Material/c")
+bad_value("range: Steps = 0", [('type="int"    value="5"', 'type="int"    value="0"')], "Time/Steps")
+bad_value("range: Steps beyond int", [('type="int"    value="5"', 'type="int"    value="99999999999"')], "Time/Steps")
+bad_value("range: Step Size = 0", [('name="Step Size" type="double" value="1"', 'name="Step Size" type="double" value="0"')],
+          "Time/Step Size")
+bad_value("range: Cells with a 0", [('value="{14, 4, 6}"', 'value="{14, 0, 6}"')], "Mesh/Cells")
+bad_value("range: Cells too many", [('value="{14, 4, 6}"', 'value="{100000, 100000, 100000}"')], "Mesh/Cells")
+bad_value("range: Max below Min", [('value="{7, 1.75, 4}"', 'value="{7, -1.75, 4}"')], "Mesh/Max")
+bad_value("range: nan in Min", [('value="{0, 0, 0}"', 'value="{nan, 0, 0}"')], "Mesh/Min")
+bad_value("range: 1e999 in Velocity", [('value="{0, -0.1, 0}"', 'value="{0, -1e999, 0}"')], f"{C}/Velocity")
+bad_value("range: negative friction", [('<Parameter name="Law" type="string" value="None"/>',
+                                        '<Parameter name="Law" type="string" value="Tanh"/>'
+                                        '<Parameter name="Coefficient" type="double" value="-0.1"/>')],
+          f"{C}/Friction/Coefficient")
+bad_value("range: Checkpoint Every = -1", [('<Parameter name="Directory"',
+                                            '<Parameter name="Checkpoint Every" type="int" value="-1"/>'
+                                            '<Parameter name="Directory"')], "Output/Checkpoint Every")
+
+# --- wrong array lengths ----------------------------------------------------------------
+bad_value("length: Min with 2 values", [('value="{0, 0, 0}"', 'value="{0, 0}"')], "Mesh/Min")
+bad_value("length: Axis Point with 4 values", [(POINT, POINT.replace("{3.5, 3.75, 0}", "{3.5, 3.75, 0, 1}"))],
+          f"{C}/Axis Point")
+bad_value("length: empty Cells", [('value="{14, 4, 6}"', 'value="{}"')], "Mesh/Cells")
+bad_value("length: not a list", [('value="{0, 0, 0}"', 'value="0, 0, 0"')], "Mesh/Min")
+
+# --- unknown face names -------------------------------------------------------------------
+bad_value("face: support on 'top'", [('name="Face" type="string" value="ymin"', 'name="Face" type="string" value="top"')],
+          "Supports/base/Face")
+bad_value("face: contact face 'top'", [('value="ymax"', 'value="ymax top"')], f"{C}/Contact Faces")
+
+# --- zero axis direction, radius <= 0 ---------------------------------------------------------
+bad_value("axis direction {0, 0, 0}", [(AXIS, AXIS.replace("{0, 0, 1}", "{0, 0, 0}"))], f"{C}/Axis Direction")
+bad_value("Radius = 0", [(RADIUS, RADIUS.replace('"2"', '"0"'))], f"{C}/Radius")
+bad_value("Radius = -2", [(RADIUS, RADIUS.replace('"2"', '"-2"'))], f"{C}/Radius")
+
+# --- malformed XML ------------------------------------------------------------------------
+f = scene_file("unclosed.xml", G1[: G1.index('<ParameterList name="Time">')])
+case("XML: unclosed element", f, [f, "XML"])
+f = scene_file("mismatched.xml", edited(('<ParameterList name="Time">', '<Foo name="Time">')))
+case("XML: mismatched tag", f, [f, "XML"])
+f = scene_file("deep.xml", '<ParameterList name="Scene">' + '<ParameterList name="a">' * 100000 +
+               '</ParameterList>' * 100000 + '</ParameterList>')
+case("XML: 100000 nested lists", f, [f, "nested deeper"])
+bad_value("XML: unknown element", [('<ParameterList name="Time">', '<ParameterList name="Time"><Foo/>')], "Time")
+bad_value("XML: parameter twice", [('<Parameter name="c" type="double" value="1"/>',
+                                    '<Parameter name="c" type="double" value="1"/><Parameter name="c" type="double" value="2"/>')],
+          "Material/c")
+bad_value("XML: no value attribute", [('<Parameter name="c" type="double" value="1"/>', '<Parameter name="c" type="double"/>')],
+          "Material/c")
+f = scene_file("text.xml", "just some text\n")
+case("XML: plain text", f, [f, "XML"])
+
+# --- empty, binary, missing ---------------------------------------------------------------
+f = scene_file("empty.xml", "")
+case("empty file", f, [f, "empty"])
+f = scene_file("blank.xml", "  \n\t\n")
+case("blank file", f, [f, "empty"])
+f = scene_file("garbage.xml", bytes((i * 151 + 7) % 256 for i in range(4096)))
+case("binary garbage", f, [f, "binary"])
+f = scene_file("garbage-tail.xml", G1[:300].encode() + b"\x00\x01\x02\xff" * 64)
+case("XML then binary garbage", f, [f, "binary"])
+f = os.path.join(scenes, "no-such-scene.xml")
+case("missing scene file", f, [f, "cannot open"])
+case("a directory as the scene", scenes, [scenes, "directory"])
+
+# --- unwritable output directory: a path under a regular file --------------------------------
+good = scene_file("good.xml", G1)
+regular = T.path("a-regular-file")
+with open(regular, "w") as fh:
+    fh.write("not a directory\n")
+before = os.stat(regular).st_mtime_ns
+for sub in ("out", "deeper/out"):
+    target = os.path.join(regular, sub)
+    p = T.capstan_run(["run", good, "--output", target, "--quiet"], cwd=work)
+    T.check(p.returncode == 1, f"output under a regular file ({sub}): exit status {p.returncode} (1)")
+    err = p.stderr.strip()
+    T.check(good in err and "Output/Directory" in err,
+            f"output under a regular file ({sub}): stderr names the file and 'Output/Directory': {err[:260]}")
+    T.check(os.path.isfile(regular) and os.stat(regular).st_mtime_ns == before,
+            f"output under a regular file ({sub}): the regular file is untouched")
+T.check(listing(work) == {}, "output under a regular file: working directory unchanged")
+
+# --- Trilinos sublists, ranks, --set -----------------------------------------------------------
+bad_value("NOX: unknown solver", [('<ParameterList name="Output">',
+                                   '<ParameterList name="Solver"><ParameterList name="NOX">'
+                                   '<Parameter name="Nonlinear Solver" type="string" value="Bogus"/>'
+                                   '</ParameterList></ParameterList><ParameterList name="Output">')], "Solver/NOX")
+bad_value("Stratimikos: unknown solver", [('<ParameterList name="Output">',
+                                           '<ParameterList name="Solver"><ParameterList name="Stratimikos">'
+                                           '<Parameter name="Linear Solver Type" type="string" value="Bogus"/>'
+                                           '</ParameterList></ParameterList><ParameterList name="Output">')],
+          "Solver/Stratimikos")
+f = scene_file("one-cell.xml", edited(('value="{14, 4, 6}"', 'value="{1, 1, 1}"')))
+case("one cell on 2 ranks", f, [f, "Mesh/Cells"], ranks=2)
+case("--set: 1e999", good, [good, "Material/c"], args=["--set", "Material/c=1e999"])
+case("--set: list with a word", good, [good, "Mesh/Cells"], args=["--set", "Mesh/Cells={4,two,2}"])
+case("--set: 2 ranks, negative radius", good, [good, f"{C}/Radius"], args=["--set", f"{C}/Radius=-1"], ranks=2)
+
+# --- a capstan that can never touch its faces: warning, the run goes on ------------------------
+far = scene_file("far.xml", edited((POINT, POINT.replace("{3.5, 3.75, 0}", "{3.5, 100, 0}"))))
+p, s, _ = T.run_scene(far, "far", sets=["Time/Steps=1"])
+err = p.stderr.strip()
+T.check("WARNING" in err and far in err and "Capstans/capstan" in err and "never touch" in err,
+        f"unreachable capstan: warning naming the file and the capstan: {err[:300]}")
+T.check(s is not None and s["converged"] and s["steps"][0]["capstans"]["capstan"]["contact_points"] == 0,
+        "unreachable capstan: the run goes on (converged, 0 contact points)")
+p = T.capstan_run(["validate", far], cwd=work)
+T.check(p.returncode == 0 and "never touch" in p.stderr, f"unreachable capstan: validate warns too, exit {p.returncode}")
+# Near misses are not flagged: G1 itself, a capstan that starts 40 away but moves
+# 50 towards the body, a capstan far along its own (infinite) axis, and one whose
+# gap (1) is within the body's size (the body could deform towards it).
+for label, text in (("G1", G1),
+                    ("moving in", edited((POINT, POINT.replace("{3.5, 3.75, 0}", "{3.5, 40, 0}")),
+                                         ('value="{0, -0.1, 0}"', 'value="{0, -10, 0}"'))),
+                    ("far along its axis", edited((POINT, POINT.replace("{3.5, 3.75, 0}", "{3.5, 3.75, 1000}")))),
+                    ("gap 1", edited((POINT, POINT.replace("{3.5, 3.75, 0}", "{3.5, 4.75, 0}")),
+                                     ('value="{0, -0.1, 0}"', 'value="{0, 0, 0}"')))):
+    f = scene_file(f"near-{label.replace(' ', '_')}.xml", text)
+    p = T.capstan_run(["validate", f], cwd=work)
+    T.check(p.returncode == 0 and "WARNING" not in p.stderr,
+            f"no warning for {label}: exit {p.returncode}, stderr {p.stderr.strip()[:200]!r}")
+T.check(listing(work) == {}, "validate writes nothing")
+T.finish()

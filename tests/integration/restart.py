@@ -1,0 +1,313 @@
+#!/usr/bin/env python3
+"""Checkpoint/restart gives the results of an uninterrupted run (ctest labels
+integration, hard).
+
+The scene is inputs/seed/stick-slip.xml (augmented Lagrangian contact, Coulomb
+friction: pressure anchors, contact and tangential multipliers, stick states and
+the friction history all carry over between steps; every step does Newton work).
+
+  1 rank:  run it uninterrupted; run it again with Output/Checkpoint Every = 1,
+           kill it (SIGKILL) once the checkpoint of step 3 or later exists, check
+           that the killed run left a readable fields.h5 and fields.xmf, then
+           `capstan run --restart` into the same directory.
+  2 ranks: the same on a 20 x 2 x 1 mesh; and a finished run with Checkpoint
+           Every = 4 restarted from step 4 (its fields.h5 steps 5 and 6 must be
+           replaced, not duplicated).
+
+Each restarted run must list every step, and every per-step figure of
+summary.json (all numbers but wall_seconds), the rows of history.csv, and the
+displacement and pressure of every step in fields.h5 must equal the
+uninterrupted run's to 1e-10 relative.
+
+Bad restarts exit 1, name the scene file and what does not fit, and leave the
+output directory as it was: another mesh (Mesh/Cells), another step size
+(Time/Step Size), another rank count, a directory without a checkpoint.
+"""
+import csv
+import glob
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+import xml.etree.ElementTree as ET
+
+sys.dont_write_bytecode = True
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from capstan_test import Test, _quote  # noqa: E402
+
+T = Test("restart", __doc__)
+SCENE = T.input("seed/stick-slip.xml")
+STEPS = 6
+RTOL = 1e-10
+SMALL = ["Mesh/Cells={20,2,1}"]  # the 2-rank variant (GMRES on 2 ranks is slower)
+
+
+def checkpoints(out):
+    """Step numbers of the complete checkpoints in OUT."""
+    steps = []
+    for d in glob.glob(os.path.join(out, "checkpoint", "step-*")):
+        name = os.path.basename(d)
+        if name[5:].isdigit() and os.path.isfile(os.path.join(d, "rank-00000.bin")):
+            steps.append(int(name[5:]))
+    return sorted(steps)
+
+
+def descendants(pid):
+    """Process ids of PID's children, grandchildren, ... (from /proc)."""
+    children = {}
+    for entry in os.listdir("/proc"):
+        if not entry.isdigit():
+            continue
+        try:
+            with open(f"/proc/{entry}/stat") as f:
+                stat = f.read()
+        except OSError:
+            continue
+        ppid = int(stat[stat.rindex(")") + 2:].split()[1])
+        children.setdefault(ppid, []).append(int(entry))
+    out, todo = [], [pid]
+    while todo:
+        for c in children.get(todo.pop(), []):
+            out.append(c)
+            todo.append(c)
+    return out
+
+
+def kill_job(p):
+    """SIGKILL to the driver and every process it started (mpiexec's ranks may sit
+    in process groups of their own), leaves first; waits until all are gone."""
+    pids = descendants(p.pid)
+    for pid in reversed(pids):
+        try:
+            os.kill(pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+    p.kill()
+    p.wait()
+    deadline = time.time() + 30
+    while time.time() < deadline and any(os.path.exists(f"/proc/{pid}") and not _zombie(pid) for pid in pids):
+        time.sleep(0.01)
+
+
+def _zombie(pid):
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            stat = f.read()
+        return stat[stat.rindex(")") + 2] == "Z"
+    except OSError:
+        return True
+
+
+def run_and_kill(tag, sets, ranks, after_step):
+    """Starts the scene with Checkpoint Every = 1 and kills it (SIGKILL to mpiexec
+    and its ranks) once a checkpoint of AFTER_STEP or later exists. Returns the
+    output directory and the step of its checkpoint."""
+    out = T.path(tag)
+    args = ["run", SCENE, "--output", out, "--quiet", "--set", "Output/Checkpoint Every=1"]
+    for s in sets:
+        args += ["--set", s]
+    cmd = T.command(args, ranks)
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+               OMPI_MCA_rmaps_base_oversubscribe="1")
+    print("  $ " + " ".join(_quote(c) for c in cmd) + "   (killed later)")
+    p = subprocess.Popen(cmd, cwd=T.dir, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    deadline = time.time() + 120
+    while time.time() < deadline and p.poll() is None:
+        if any(k >= after_step for k in checkpoints(out)):
+            break
+        time.sleep(0.005)
+    running = p.poll() is None
+    if running:
+        kill_job(p)
+    else:
+        p.wait()
+    err = p.stderr.read().decode(errors="replace")
+    if not T.check(running, f"{tag}: still running when the checkpoint of step >= {after_step} appeared "
+                            f"(exit {p.returncode}) {err[-300:]}"):
+        T.finish()
+    found = checkpoints(out)
+    T.check(len(found) == 1 and after_step <= found[-1] < STEPS,
+            f"{tag}: killed with checkpoint {found} (one, of a step in [{after_step}, {STEPS - 1}])")
+    time.sleep(1)
+    T.check(checkpoints(out) == found, f"{tag}: nothing runs on after the kill (checkpoints {checkpoints(out)})")
+    return out, found[-1] if found else None
+
+
+def killed_outputs_readable(tag, out, k):
+    """What a killed run leaves: fields.h5 opens and holds steps 0..k at least;
+    fields.xmf parses and indexes only steps fields.h5 holds; history.csv rows >= k."""
+    import h5py
+    try:
+        with h5py.File(os.path.join(out, "fields.h5"), "r") as f:
+            steps = sorted(int(s) for s in f["steps"].keys())
+            for s in steps:
+                f["steps"][f"{s:06d}"]["nodes"]["displacement"][()]
+        ok = steps[: k + 1] == list(range(k + 1))
+        T.check(ok, f"{tag}: killed run's fields.h5 readable, steps {steps} (0..{k} at least)")
+    except Exception as e:  # noqa: BLE001 - any failure to read is the finding
+        T.check(False, f"{tag}: killed run's fields.h5 readable: {e}")
+        steps = []
+    try:
+        grids = ET.parse(os.path.join(out, "fields.xmf")).getroot().iter("Time")
+        n = sum(1 for _ in grids)
+        T.check(k + 1 <= n <= len(steps), f"{tag}: killed run's fields.xmf parses, {n} steps indexed")
+    except ET.ParseError as e:
+        T.check(False, f"{tag}: killed run's fields.xmf parses: {e}")
+    with open(os.path.join(out, "history.csv")) as f:
+        rows = list(csv.DictReader(f))
+    T.check(len(rows) >= k, f"{tag}: killed run's history.csv has {len(rows)} rows (>= {k})")
+
+
+def restart(tag, out, sets, ranks, k):
+    args = ["run", SCENE, "--output", out, "--restart", out]
+    for s in sets:
+        args += ["--set", s]
+    p = T.capstan_run(args, ranks=ranks)
+    T.check(p.returncode == 0, f"{tag}: restart exit status {p.returncode} (0) {p.stderr[-300:]}")
+    lines = [ln for ln in p.stdout.splitlines() if ln.startswith("step ")]
+    T.check(p.stdout.startswith("restart from") and f"step-{k:06d}" in p.stdout.splitlines()[0],
+            f"{tag}: restarted from step {k}: {p.stdout.splitlines()[0] if p.stdout else '(no output)'}")
+    T.check(len(lines) == STEPS - k and lines[0].startswith(f"step {k + 1}/"),
+            f"{tag}: ran steps {k + 1}..{STEPS} only ({len(lines)} progress lines)")
+
+
+def per_step_figures(summary):
+    """{'step 3 capstans.capstan.force[1]': value, ...}: every number of every step
+    but wall_seconds."""
+    out = {}
+
+    def walk(prefix, v):
+        if isinstance(v, dict):
+            for k, x in v.items():
+                if k != "wall_seconds":
+                    walk(f"{prefix}.{k}" if prefix else k, x)
+        elif isinstance(v, list):
+            for i, x in enumerate(v):
+                walk(f"{prefix}[{i}]", x)
+        elif isinstance(v, (int, float)) and not isinstance(v, bool):
+            out[prefix] = float(v)
+        else:
+            out[prefix] = v
+
+    for st in summary["steps"]:
+        walk(f"step {st['step']}", st)
+    return out
+
+
+def close(a, b):
+    if a == b:
+        return True
+    if not (isinstance(a, float) and isinstance(b, float)):
+        return False
+    return abs(a - b) <= RTOL * max(abs(a), abs(b))
+
+
+def compare(tag, ref_out, out):
+    import json
+
+    import numpy as np
+    from capstan_test import read_fields
+    with open(os.path.join(ref_out, "summary.json")) as f:
+        ref = json.load(f)
+    with open(os.path.join(out, "summary.json")) as f:
+        got = json.load(f)
+    T.check(got["converged"] is True and [s["step"] for s in got["steps"]] == list(range(1, STEPS + 1)),
+            f"{tag}: summary.json converged, lists steps {[s['step'] for s in got['steps']]}")
+    a, b = per_step_figures(ref), per_step_figures(got)
+    bad = [k for k in a if k not in b or not close(a[k], b[k])]
+    worst = max((abs(a[k] - b[k]) / max(abs(a[k]), abs(b[k])) for k in a
+                 if k in b and isinstance(a[k], float) and isinstance(b[k], float) and a[k] != b[k]), default=0.0)
+    T.check(not bad and set(a) == set(b),
+            f"{tag}: all {len(a)} per-step figures of summary.json agree (largest relative difference "
+            f"{worst:.1e}; differing: {bad[:4]})")
+    T.conforms(out, SCENE)
+
+    def rows(d):
+        with open(os.path.join(d, "history.csv")) as f:
+            return [{k: v for k, v in r.items() if k != "wall_seconds"} for r in csv.DictReader(f)]
+    ra, rb = rows(ref_out), rows(out)
+    same = len(ra) == len(rb) == STEPS and all(
+        set(x) == set(y) and all(close(float(x[k]), float(y[k])) for k in x) for x, y in zip(ra, rb))
+    T.check(same, f"{tag}: history.csv: {len(rb)} rows, equal to the uninterrupted run's ({len(ra)})")
+
+    fa, fb = read_fields(os.path.join(ref_out, "fields.h5")), read_fields(os.path.join(out, "fields.h5"))
+    T.check(sorted(fb) == list(range(STEPS + 1)), f"{tag}: fields.h5 holds steps {sorted(fb)} (0..{STEPS})")
+    worst_u = worst_p = 0.0
+    for s in fa:
+        if s not in fb:
+            continue
+        for key, name in (("u", "displacement"), ("pressure", "pressure")):
+            x, y = fa[s][key], fb[s][key]
+            if x.shape != y.shape:
+                T.check(False, f"{tag}: step {s} {name} shape {y.shape} (expected {x.shape})")
+                continue
+            scale = float(np.abs(x).max())
+            d = float(np.abs(x - y).max())
+            rel = 0.0 if d == 0 else (d / scale if scale > 0 else math.inf)
+            if key == "u":
+                worst_u = max(worst_u, rel)
+            else:
+                worst_p = max(worst_p, rel)
+    T.check(worst_u <= RTOL and worst_p <= RTOL,
+            f"{tag}: fields.h5 displacement and pressure of every step agree (largest relative "
+            f"difference {worst_u:.1e}, {worst_p:.1e}; <= {RTOL:.0e})")
+    with open(os.path.join(out, "fields.xmf")) as f:
+        n = sum(1 for _ in ET.parse(f).getroot().iter("Time"))
+    T.check(n == STEPS + 1, f"{tag}: fields.xmf indexes {n} steps ({STEPS + 1})")
+
+
+def snapshot(d):
+    out = {}
+    for root, dirs, files in os.walk(d):
+        for n in dirs + files:
+            p = os.path.join(root, n)
+            st = os.stat(p)
+            out[os.path.relpath(p, d)] = (st.st_size, st.st_mtime_ns)
+    return out
+
+
+def bad_restart(label, out, args, ranks, needles):
+    before = snapshot(out)
+    p = T.capstan_run(["run", SCENE, "--output", out, "--restart", out] + args, ranks=ranks)
+    T.check(p.returncode == 1, f"{label}: exit status {p.returncode} (1)")
+    err = p.stderr.strip()
+    for n in needles:
+        T.check(n in err, f"{label}: stderr names {n!r}: {err.splitlines()[0][:300] if err else '(empty)'}")
+    after = snapshot(out)
+    changed = sorted(k for k in set(before) | set(after) if before.get(k) != after.get(k))
+    T.check(not changed, f"{label}: output directory unchanged (changed: {changed[:5]})")
+
+
+# --- 1 rank ----------------------------------------------------------------
+t0 = time.time()
+_, s, ref1 = T.run_scene(SCENE, "uninterrupted-1")
+out1, k1 = run_and_kill("killed-1", [], 1, 3)
+if k1 is not None:
+    killed_outputs_readable("1 rank", out1, k1)
+    restart("1 rank", out1, [], 1, k1)
+    compare("1 rank", ref1, out1)
+print(f"    1 rank: {time.time() - t0:.1f} s")
+
+# --- 2 ranks ---------------------------------------------------------------
+t0 = time.time()
+_, s, ref2 = T.run_scene(SCENE, "uninterrupted-2", sets=SMALL, ranks=2)
+out2, k2 = run_and_kill("killed-2", SMALL, 2, 3)
+if k2 is not None:
+    killed_outputs_readable("2 ranks", out2, k2)
+    restart("2 ranks", out2, SMALL, 2, k2)
+    compare("2 ranks", ref2, out2)
+# A finished run restarted from its step-4 checkpoint: steps 5 and 6 are redone.
+_, s, out3 = T.run_scene(SCENE, "finished-2", sets=SMALL + ["Output/Checkpoint Every=4"], ranks=2)
+T.check(checkpoints(out3) == [4], f"Checkpoint Every = 4: checkpoints {checkpoints(out3)} ([4], only the newest)")
+restart("2 ranks, from a finished run", out3, SMALL, 2, 4)
+compare("2 ranks, from a finished run", ref2, out3)
+print(f"    2 ranks: {time.time() - t0:.1f} s")
+
+# --- bad restarts ------------------------------------------------------------
+bad_restart("another mesh", out1, ["--set", "Mesh/Cells={40,4,2}"], 1, [SCENE, "Mesh/Cells"])
+bad_restart("another step size", out1, ["--set", "Time/Step Size=0.01"], 1, [SCENE, "Time/Step Size"])
+bad_restart("2-rank checkpoint on 1 rank", out2, ["--set", SMALL[0]], 1, [SCENE, "2 rank(s)"])
+bad_restart("no checkpoint", ref1, [], 1, [SCENE, "no checkpoint"])
+T.finish()

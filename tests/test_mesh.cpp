@@ -1,0 +1,119 @@
+// Mesh generators: the annulus (pinch-roller coating) is a closed ring of
+// bricks with positive Jacobians, the right volume, outward-facing boundary
+// faces and a symmetric dual graph; it distributes like the box.
+#include <gtest/gtest.h>
+
+#include <Tpetra_Core.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "kernels/hex_shape.hpp"
+#include "mesh.hpp"
+
+using namespace capstan;
+
+namespace {
+
+std::array<double, 3> sub(const std::array<double, 3>& a, const std::array<double, 3>& b) {
+  return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+}
+std::array<double, 3> cross(const std::array<double, 3>& a, const std::array<double, 3>& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+
+}  // namespace
+
+TEST(Annulus, BricksVolumeFacesAndNeighbours) {
+  const std::array<double, 3> c{1.0, -2.0, 0.5};
+  const double ri = 4.25, ro = 6.25, length = 3.0;
+  const std::array<int, 3> cells{3, 24, 2};
+  AnnulusGenerator gen(c, ri, ro, length, cells);
+  ASSERT_EQ(gen.numElements(), 3 * 24 * 2);
+  ASSERT_EQ(gen.numNodes(), 4 * 24 * 3);
+
+  // Every Gauss point has det J > 0, and the volumes add up to the polygonal
+  // annulus (the bricks' straight edges): n/2 sin(2 pi/n) (ro^2 - ri^2) L.
+  double volume = 0;
+  for (GO e = 0; e < gen.numElements(); ++e) {
+    double X[8][3];
+    const auto nodes = gen.elementNodes(e);
+    for (int a = 0; a < 8; ++a) {
+      const auto x = gen.nodeCoordinates(nodes[a]);
+      for (int i = 0; i < 3; ++i) X[a][i] = x[i];
+    }
+    for (int q = 0; q < 8; ++q) {
+      double D[8][3];
+      const double det = kernels::hexReferenceGradients(X, kernels::gauss2(q & 1), kernels::gauss2((q >> 1) & 1),
+                                                        kernels::gauss2(q >> 2), D);
+      ASSERT_GT(det, 0) << "element " << e;
+      volume += det;
+    }
+  }
+  const double n = cells[1];
+  EXPECT_NEAR(volume, 0.5 * n * std::sin(2 * M_PI / n) * (ro * ro - ri * ri) * length, 1e-10 * volume);
+
+  // Boundary faces: counts, and normals pointing out of the ring.
+  std::map<std::string, int> count;
+  for (GO e = 0; e < gen.numElements(); ++e)
+    for (const auto& f : gen.boundaryFaces(e)) {
+      ++count[f.name];
+      std::array<std::array<double, 3>, 4> p;
+      for (int a = 0; a < 4; ++a) p[a] = gen.nodeCoordinates(f.nodes[a]);
+      const auto normal = cross(sub(p[1], p[0]), sub(p[3], p[0]));
+      std::array<double, 3> mid{0, 0, 0};
+      for (int a = 0; a < 4; ++a)
+        for (int i = 0; i < 3; ++i) mid[i] += 0.25 * p[a][i];
+      const double rx = mid[0] - c[0], ry = mid[1] - c[1];
+      const double radial = (normal[0] * rx + normal[1] * ry) / std::hypot(rx, ry);
+      if (f.name == "inner") {
+        EXPECT_LT(radial, 0);
+        EXPECT_NEAR(std::hypot(p[0][0] - c[0], p[0][1] - c[1]), ri, 1e-12);
+      } else if (f.name == "outer") {
+        EXPECT_GT(radial, 0);
+        EXPECT_NEAR(std::hypot(p[0][0] - c[0], p[0][1] - c[1]), ro, 1e-12);
+      } else if (f.name == "zmin") {
+        EXPECT_LT(normal[2], 0);
+        EXPECT_NEAR(mid[2], c[2], 1e-12);
+      } else {
+        ASSERT_EQ(f.name, "zmax");
+        EXPECT_GT(normal[2], 0);
+        EXPECT_NEAR(mid[2], c[2] + length, 1e-12);
+      }
+    }
+  EXPECT_EQ(count["inner"], 24 * 2);
+  EXPECT_EQ(count["outer"], 24 * 2);
+  EXPECT_EQ(count["zmin"], 3 * 24);
+  EXPECT_EQ(count["zmax"], 3 * 24);
+
+  // The dual graph is symmetric, closed around the circumference, and two
+  // neighbours share exactly 4 nodes (a face).
+  for (GO e = 0; e < gen.numElements(); ++e) {
+    const auto nb = gen.faceNeighbours(e);
+    const auto ne = gen.elementNodes(e);
+    for (GO m : nb) {
+      const auto back = gen.faceNeighbours(m);
+      EXPECT_NE(std::find(back.begin(), back.end(), e), back.end()) << e << " -> " << m;
+      const auto nm = gen.elementNodes(m);
+      int shared = 0;
+      for (GO a : ne) shared += std::count(nm.begin(), nm.end(), a);
+      EXPECT_EQ(shared, 4) << e << " and " << m;
+    }
+  }
+  // Element (0, 23, 0) and (0, 0, 0) are neighbours across the angle 0.
+  const auto last = gen.faceNeighbours(23 * 3);
+  EXPECT_NE(std::find(last.begin(), last.end(), 0), last.end());
+}
+
+TEST(Annulus, DistributesWithFaces) {
+  AnnulusGenerator gen({0, 0, 0}, 1.0, 2.0, 1.0, {2, 12, 2});
+  const Mesh mesh = distributeMesh(gen, Tpetra::getDefaultComm());
+  EXPECT_EQ(mesh.numGlobalElements, 2 * 12 * 2);
+  EXPECT_EQ(mesh.numGlobalNodes, 3 * 12 * 3);
+  EXPECT_EQ(mesh.faces.count("inner"), 1u);
+  EXPECT_EQ(mesh.faces.at("inner").size() % 4, 0u);
+  // Inner-face nodes all lie on the inner radius.
+  for (int n : mesh.faceNodes("inner"))
+    EXPECT_NEAR(std::hypot(mesh.X[3 * n], mesh.X[3 * n + 1]), 1.0, 1e-12);
+}
