@@ -4,7 +4,8 @@ value, and report each quantity of interest's error against the sweep's referenc
 together with the run's wall time.
 
     scripts/study.py SCENE.xml --out DIR --sweep KNOB=V1,V2,... [--sweep ...]
-                     [--set PATH=VALUE ...] [--capstan build/capstan] [--ranks N]
+                     [--set PATH=VALUE ...] [--reference-set PATH=VALUE ...] [--face NAME ...]
+                     [--columns q1,q2,...] [--capstan build/capstan] [--ranks N]
 
 KNOB is a parameter path of the scene (as for `capstan run --set`), or one of the
 shorthands
@@ -163,11 +164,18 @@ def main():
     ap.add_argument("--capstan", default=os.path.join(os.path.dirname(__file__), "..", "build", "capstan"))
     ap.add_argument("--ranks", type=int, default=1)
     ap.add_argument("--no-plot", action="store_true")
+    ap.add_argument("--face", action="append", default=[],
+                    help="a face whose mean displacement (node_displacement_mean) is a quantity: "
+                         "adds <face>_mean_ux, _uy, _uz")
     ap.add_argument("--columns", default="",
                     help="comma-separated quantities for study.md and study.png (default: all that apply)")
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)
     base = scene_values(args.scene, args.set)
+    for face in args.face:
+        for i, comp in enumerate("xyz"):
+            QUANTITIES[f"{face}_mean_u{comp}"] = (
+                lambda s, face=face, i=i: s["final"]["node_displacement_mean"].get(face, [None] * 3)[i])
     shown = [c for c in args.columns.split(",") if c]
     for c in shown:
         if c not in QUANTITIES:

@@ -48,10 +48,17 @@ ParameterList validParameters() {
         "costs on G1 and H1: docs/accuracy.md");
 
   auto& mesh = p.sublist("Mesh", false, "The rubber body's mesh");
-  mesh.set("Type", std::string("Box"), "Box (structured brick mesh; faces xmin xmax ymin ymax zmin zmax)");
+  mesh.set("Type", std::string("Box"),
+           "Box (structured brick mesh; faces xmin xmax ymin ymax zmin zmax) | Annulus (hollow "
+           "cylinder along +z: radial x circumferential x axial bricks; faces inner outer zmin zmax)");
   mesh.set("Min", vec3(0, 0, 0), "Box: lower corner {x, y, z}");
   mesh.set("Max", vec3(1, 1, 1), "Box: upper corner {x, y, z}, each above Min");
-  mesh.set("Cells", Array<int>(Teuchos::tuple(4, 4, 4)), "Box: bricks along x, y, z (each >= 1)");
+  mesh.set("Cells", Array<int>(Teuchos::tuple(4, 4, 4)),
+           "Box: bricks along x, y, z (each >= 1). Annulus: radial, circumferential (>= 3), axial");
+  mesh.set("Center", vec3(0, 0, 0), "Annulus: the axis point at the zmin end (the axis is along +z)");
+  mesh.set("Inner Radius", 1.0, "Annulus: inner radius > 0 (the bonded face 'inner')");
+  mesh.set("Outer Radius", 2.0, "Annulus: outer radius > Inner Radius");
+  mesh.set("Length", 1.0, "Annulus: length along z > 0");
 
   auto& mat = p.sublist("Material", false, "Rubber (formulation.md §1)");
   mat.set("Model", std::string("Incompressible Neo-Hookean"),
@@ -430,7 +437,9 @@ void warnUnreachable(Scene& sc, const CapstanSpec& c) {
     }
   std::array<double, 3> lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
   for (const auto& face : c.contactFaces) {
-    const int axis = face[0] - 'x';
+    // A box face is one side of the box; any other (annulus) face: the whole box.
+    const bool boxFace = m.type == "Box";
+    const int axis = boxFace ? face[0] - 'x' : -1;
     const bool isMax = face.substr(1) == "max";
     for (int i = 0; i < 3; ++i) {
       const double a = i == axis ? (isMax ? m.max[i] : m.min[i]) : m.min[i];
@@ -609,6 +618,11 @@ void applyAccuracyPreset(ParameterList& user, const Validator& v) {
 
 }  // namespace
 
+std::vector<std::string> MeshSpec::faceNames() const {
+  if (type == "Annulus") return {"inner", "outer", "zmin", "zmax"};
+  return {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
+}
+
 Scene loadScene(const std::string& file, const std::vector<std::string>& sets,
                 const std::string& outputOverride) {
   std::error_code ec;
@@ -643,22 +657,40 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
 
   const auto& mesh = P.sublist("Mesh");
   sc.mesh.type = mesh.get<std::string>("Type");
-  if (sc.mesh.type != "Box") v.fail("Mesh/Type", "'" + sc.mesh.type + "' is not a mesh type (Box)");
-  sc.mesh.min = three<double>(mesh, "Min", v, "Mesh");
-  sc.mesh.max = three<double>(mesh, "Max", v, "Mesh");
   sc.mesh.cells = three<int>(mesh, "Cells", v, "Mesh");
-  for (int d = 0; d < 3; ++d) {
-    if (!(sc.mesh.max[d] > sc.mesh.min[d]))
-      v.fail("Mesh/Max", "each component must exceed Mesh/Min (zero or negative size)");
+  for (int d = 0; d < 3; ++d)
     if (sc.mesh.cells[d] < 1) v.fail("Mesh/Cells", "each count must be >= 1");
+  double nodes = 0;
+  if (sc.mesh.type == "Box") {
+    sc.mesh.min = three<double>(mesh, "Min", v, "Mesh");
+    sc.mesh.max = three<double>(mesh, "Max", v, "Mesh");
+    for (int d = 0; d < 3; ++d)
+      if (!(sc.mesh.max[d] > sc.mesh.min[d]))
+        v.fail("Mesh/Max", "each component must exceed Mesh/Min (zero or negative size)");
+    nodes = double(sc.mesh.cells[0] + 1.0) * (sc.mesh.cells[1] + 1.0) * (sc.mesh.cells[2] + 1.0);
+  } else if (sc.mesh.type == "Annulus") {
+    auto& m = sc.mesh;
+    m.center = three<double>(mesh, "Center", v, "Mesh");
+    for (double x : m.center)
+      if (!std::isfinite(x)) v.fail("Mesh/Center", "must be finite numbers");
+    m.innerRadius = positive(mesh, "Inner Radius", v, "Mesh");
+    m.outerRadius = positive(mesh, "Outer Radius", v, "Mesh");
+    m.length = positive(mesh, "Length", v, "Mesh");
+    if (!(m.outerRadius > m.innerRadius)) v.fail("Mesh/Outer Radius", "must exceed Mesh/Inner Radius");
+    if (m.cells[1] < 3) v.fail("Mesh/Cells", "an annulus needs at least 3 circumferential cells");
+    m.min = {m.center[0] - m.outerRadius, m.center[1] - m.outerRadius, m.center[2]};
+    m.max = {m.center[0] + m.outerRadius, m.center[1] + m.outerRadius, m.center[2] + m.length};
+    nodes = double(m.cells[0] + 1.0) * m.cells[1] * (m.cells[2] + 1.0);
+  } else {
+    v.fail("Mesh/Type", "'" + sc.mesh.type + "' is not a mesh type (Box, Annulus)");
   }
-  {
-    // Local dof ids are ints: 3 x nodes must stay below 2^31.
-    const double nodes = double(sc.mesh.cells[0] + 1.0) * (sc.mesh.cells[1] + 1.0) * (sc.mesh.cells[2] + 1.0);
-    if (3 * nodes > double(INT_MAX))
-      v.fail("Mesh/Cells", "too many cells: " + shortest(nodes) + " nodes, capstan indexes at most 2^31 / 3");
-  }
-  const std::set<std::string> faceNames = {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
+  // Local dof ids are ints: 3 x nodes must stay below 2^31.
+  if (3 * nodes > double(INT_MAX))
+    v.fail("Mesh/Cells", "too many cells: " + shortest(nodes) + " nodes, capstan indexes at most 2^31 / 3");
+  const std::vector<std::string> faceList = sc.mesh.faceNames();
+  const std::set<std::string> faceNames(faceList.begin(), faceList.end());
+  std::string faceText;
+  for (const auto& f : faceList) faceText += (faceText.empty() ? "" : " ") + f;
 
   const auto& mat = P.sublist("Material");
   if (mat.get<std::string>("Model") != "Incompressible Neo-Hookean")
@@ -678,7 +710,7 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
     spec.name = name;
     spec.face = s.get<std::string>("Face");
     spec.type = s.get<std::string>("Type");
-    if (!faceNames.count(spec.face)) v.fail(path + "/Face", "'" + spec.face + "' is not a face of the mesh (xmin xmax ymin ymax zmin zmax)");
+    if (!faceNames.count(spec.face)) v.fail(path + "/Face", "'" + spec.face + "' is not a face of the mesh (" + faceText + ")");
     if (spec.type == "Fixed") spec.components = {true, true, true};
     else if (spec.type == "Roller" || spec.type == "Foundation" || spec.type == "Displacement")
       spec.components = components(s.get<std::string>("Components"), v, path + "/Components");
@@ -711,7 +743,7 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
     cs.contactFaces = splitNames(c.get<std::string>("Contact Faces"));
     if (cs.contactFaces.empty()) v.fail(path + "/Contact Faces", "name at least one face");
     for (const auto& f : cs.contactFaces)
-      if (!faceNames.count(f)) v.fail(path + "/Contact Faces", "'" + f + "' is not a face of the mesh");
+      if (!faceNames.count(f)) v.fail(path + "/Contact Faces", "'" + f + "' is not a face of the mesh (" + faceText + ")");
     const auto& ct = c.sublist("Contact");
     cs.method = ct.get<std::string>("Method");
     if (cs.method != "Penalty" && cs.method != "Augmented Lagrangian")

@@ -11,9 +11,13 @@
 namespace capstan {
 
 struct MeshSpec {
-  std::string type;  // Box
-  std::array<double, 3> min{}, max{};
-  std::array<int, 3> cells{};
+  std::string type;  // Box | Annulus
+  std::array<double, 3> min{}, max{};  // Box: its corners; Annulus: its bounding box
+  std::array<int, 3> cells{};          // Box: x, y, z; Annulus: radial, circumferential, axial
+  // Annulus: axis point at the zmin end (axis along +z), radii, length.
+  std::array<double, 3> center{};
+  double innerRadius = 0, outerRadius = 0, length = 0;
+  std::vector<std::string> faceNames() const;
 };
 
 struct SupportSpec {

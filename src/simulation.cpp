@@ -212,7 +212,7 @@ class Run {
   RunOptions opt_;
   bool rank0_;
   Clock::time_point t0_;
-  std::unique_ptr<BoxGenerator> generator_;
+  std::unique_ptr<MeshGenerator> generator_;
   Mesh mesh_;
   std::unique_ptr<Assembly> assembly_;
   std::unique_ptr<NewtonSolver> newton_;
@@ -1039,7 +1039,10 @@ int Run::execute() {
   Restart restart;
   if (!opt_.restart.empty()) openRestart(restart);
 
-  generator_ = std::make_unique<BoxGenerator>(m.min, m.max, m.cells);
+  if (m.type == "Annulus")
+    generator_ = std::make_unique<AnnulusGenerator>(m.center, m.innerRadius, m.outerRadius, m.length, m.cells);
+  else
+    generator_ = std::make_unique<BoxGenerator>(m.min, m.max, m.cells);
   mesh_ = distributeMesh(*generator_, comm_);
   assembly_ = std::make_unique<Assembly>(mesh_, scene_);
   try {
