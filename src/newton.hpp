@@ -34,6 +34,8 @@ class NewtonSolver {
   // solution out). Returns the Krylov iterations, or -1 if it failed.
   int linearSolve(const RCP<FEMatrix>& W, const Vector& b, Vector& x);
   double linearSolveSeconds() const;
+  // The part of linearSolveSeconds() spent setting up preconditioners.
+  double preconditionerSeconds() const;
   // The linear solver and preconditioner parameters in use (Stratimikos list).
   const Teuchos::ParameterList& linearSolverParameters() const;
 

@@ -222,7 +222,7 @@ class Run {
   fs::path dir_;
   double outputSeconds_ = 0;
   // A restarted run's summary adds the earlier run's time and kernel counts.
-  double timingOffset_[4] = {0, 0, 0, 0};  // total, assembly, linear solve, output
+  double timingOffset_[5] = {0, 0, 0, 0, 0};  // total, assembly, linear solve, output, preconditioner set-up
   std::map<std::string, std::pair<long, double>> effectOffset_;
   long numContactFaces_ = 0;  // global, each candidate face once
   double absTolerance_ = 0;
@@ -712,7 +712,8 @@ void Run::writeSummary(bool converged, const std::string& failure) {
   timing.add("total", json::number(total))
       .add("assembly", json::number(assembly_->assemblySeconds() + timingOffset_[1]))
       .add("linear_solve", json::number(newton_->linearSolveSeconds() + timingOffset_[2]))
-      .add("output", json::number(outputSeconds_ + timingOffset_[3]));
+      .add("output", json::number(outputSeconds_ + timingOffset_[3]))
+      .add("preconditioner_setup", json::number(newton_->preconditionerSeconds() + timingOffset_[4]));
   Object mesh;
   mesh.add("nodes", json::number(long(mesh_.numGlobalNodes)))
       .add("elements", json::number(long(mesh_.numGlobalElements)))
@@ -827,6 +828,7 @@ std::string Run::checkpointBytes(int step, double time) const {
     w.put<double>(assembly_->assemblySeconds() + timingOffset_[1]);
     w.put<double>(newton_->linearSolveSeconds() + timingOffset_[2]);
     w.put<double>(outputSeconds_ + timingOffset_[3]);
+    w.put<double>(newton_->preconditionerSeconds() + timingOffset_[4]);
     for (const auto& e : effects) {
       const auto offset = effectOffset_.count(e->name()) ? effectOffset_.at(e->name()) : std::pair<long, double>{};
       w.put<long>(e->launches() + offset.first), w.put<double>(e->seconds() + offset.second);
