@@ -208,6 +208,18 @@ struct FieldWriter::Impl {
 
   std::string xdmf() const;
   void writeXdmf() const;
+  // Rank 0 rewrites the index; the outcome is shared so all ranks throw together.
+  void publishXdmf() const {
+    std::string error;
+    if (rank == 0) {
+      try {
+        writeXdmf();
+      } catch (const std::exception& e) {
+        error = e.what();
+      }
+    }
+    agree(comm, error);
+  }
 };
 
 void FieldWriter::Impl::init(const std::string& dir, const FieldLayout& l) {
@@ -323,15 +335,7 @@ FieldWriter::FieldWriter(const std::string& directory, const FieldLayout& l, App
     if (m.steps.empty() || m.steps.back().group != last)
       throw std::runtime_error("FieldWriter: " + m.h5Path + " does not hold step " + std::to_string(append.lastKept));
     m.check(H5Fflush(m.file, H5F_SCOPE_GLOBAL) >= 0, "cannot flush");
-    std::string xmfError;
-    if (m.rank == 0) {
-      try {
-        m.writeXdmf();
-      } catch (const std::exception& e) {
-        xmfError = e.what();
-      }
-    }
-    agree(m.comm, xmfError);
+    m.publishXdmf();
   } catch (...) {
     if (m.file >= 0) H5Fclose(m.file);
     delete impl_;
@@ -422,17 +426,7 @@ void FieldWriter::writeStep(int step, double time, const std::vector<double>& co
   }
   m.check(H5Fflush(m.file, H5F_SCOPE_GLOBAL) >= 0, "cannot flush after step " + g);
   m.steps.push_back(rec);
-
-  // Rank 0 writes the index; the outcome is shared so all ranks throw together.
-  std::string xmfError;
-  if (m.rank == 0) {
-    try {
-      m.writeXdmf();
-    } catch (const std::exception& e) {
-      xmfError = e.what();
-    }
-  }
-  agree(m.comm, xmfError);
+  m.publishXdmf();
 }
 
 std::string FieldWriter::Impl::xdmf() const {

@@ -79,8 +79,28 @@ std::vector<GO> BoxGenerator::faceNeighbours(GO e) const {
 // ---------------------------------------------------------------- annulus generator
 
 AnnulusGenerator::AnnulusGenerator(std::array<double, 3> center, double innerRadius, double outerRadius,
-                                   double length, std::array<int, 3> cells)
-    : center_(center), ri_(innerRadius), ro_(outerRadius), length_(length), n_{cells[0], cells[1], cells[2]} {}
+                                   double length, std::array<int, 3> cells, double outerCellRatio,
+                                   std::array<double, 3> sector)
+    : center_(center), length_(length), n_{cells[0], cells[1], cells[2]} {
+  // Radii: thicknesses t_k = t_0 q^k, q^(n-1) = outerCellRatio, summing to the wall.
+  const int nr = cells[0];
+  const double q = nr > 1 ? std::pow(outerCellRatio, 1.0 / (nr - 1)) : 1.0;
+  double sum = 0;
+  for (int k = 0; k < nr; ++k) sum += std::pow(q, k);
+  radius_.assign(nr + 1, innerRadius);
+  for (int k = 0; k < nr; ++k) radius_[k + 1] = radius_[k] + (outerRadius - innerRadius) * std::pow(q, k) / sum;
+  radius_[nr] = outerRadius;
+  // Angles: uniform, or m cells over the sector's width and the rest over the remainder.
+  const int nt = cells[1];
+  const double width = sector[1] * M_PI / 180;
+  const int m = width > 0 ? std::clamp(int(std::lround(sector[2] * nt)), 1, nt - 1) : 0;
+  angle_.resize(nt);
+  const double start = m ? sector[0] * M_PI / 180 - width / 2 : 0.0;
+  for (int j = 0; j < nt; ++j)
+    angle_[j] = m == 0 ? 2 * M_PI * j / nt
+                : j <= m ? start + width * j / m
+                         : start + width + (2 * M_PI - width) * (j - m) / (nt - m);
+}
 
 GO AnnulusGenerator::numElements() const { return n_[0] * n_[1] * n_[2]; }
 GO AnnulusGenerator::numNodes() const { return (n_[0] + 1) * n_[1] * (n_[2] + 1); }
@@ -105,8 +125,7 @@ std::array<GO, 8> AnnulusGenerator::elementNodes(GO e) const {
 std::array<double, 3> AnnulusGenerator::nodeCoordinates(GO n) const {
   const GO sr = n_[0] + 1;
   const GO i = n % sr, j = (n / sr) % n_[1], k = n / (sr * n_[1]);
-  const double r = i == n_[0] ? ro_ : ri_ + (ro_ - ri_) * double(i) / double(n_[0]);
-  const double theta = 2 * M_PI * double(j) / double(n_[1]);
+  const double r = radius_[i], theta = angle_[j];
   const double z = k == n_[2] ? length_ : length_ * double(k) / double(n_[2]);
   return {center_[0] + r * std::cos(theta), center_[1] + r * std::sin(theta), center_[2] + z};
 }

@@ -58,10 +58,18 @@ class BoxGenerator : public MeshGenerator {
 // circumference (nodes at angle 2 pi are those at 0). Faces inner, outer,
 // zmin, zmax. Brick axes (radial, circumferential, axial) are right-handed, so
 // every brick has a positive Jacobian.
+//
+// Grading, so that the part of the coating that passes through the nip is fine
+// and the rest coarse: radially, the cells' thickness changes geometrically from
+// the inner to the outer face by outerCellRatio (< 1: thinner at the outer
+// face); around the circumference, sector = {centre angle, width (degrees, from
+// +x towards +y), fraction of the circumferential cells placed in it} (width 0:
+// uniform).
 class AnnulusGenerator : public MeshGenerator {
  public:
   AnnulusGenerator(std::array<double, 3> center, double innerRadius, double outerRadius, double length,
-                   std::array<int, 3> cells);
+                   std::array<int, 3> cells, double outerCellRatio = 1,
+                   std::array<double, 3> sector = {0, 0, 0});
   GO numElements() const override;
   GO numNodes() const override;
   std::vector<std::string> faceNames() const override;
@@ -72,8 +80,9 @@ class AnnulusGenerator : public MeshGenerator {
 
  private:
   std::array<double, 3> center_;
-  double ri_, ro_, length_;
+  double length_;
   std::array<GO, 3> n_;  // radial, circumferential, axial cells
+  std::vector<double> radius_, angle_;  // node radii (n_[0] + 1) and angles (n_[1])
   std::array<GO, 3> ijk(GO element) const;
   GO node(GO i, GO j, GO k) const;  // j taken modulo the circumferential count
 };

@@ -59,6 +59,12 @@ ParameterList validParameters() {
   mesh.set("Inner Radius", 1.0, "Annulus: inner radius > 0 (the bonded face 'inner')");
   mesh.set("Outer Radius", 2.0, "Annulus: outer radius > Inner Radius");
   mesh.set("Length", 1.0, "Annulus: length along z > 0");
+  mesh.set("Outer Cell Ratio", 1.0,
+           "Annulus: radial grading, thickness of the outermost cell over the innermost's (> 0; "
+           "< 1 makes the cells thinner towards the outer face, where the nip is)");
+  mesh.set("Fine Sector", vec3(0, 0, 0),
+           "Annulus: {centre angle, width (degrees, from +x towards +y), fraction of the "
+           "circumferential cells placed in it}: a finer sector where the nip is. Width 0: uniform");
 
   auto& mat = p.sublist("Material", false, "Rubber (formulation.md §1)");
   mat.set("Model", std::string("Incompressible Neo-Hookean"),
@@ -678,6 +684,13 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
     m.length = positive(mesh, "Length", v, "Mesh");
     if (!(m.outerRadius > m.innerRadius)) v.fail("Mesh/Outer Radius", "must exceed Mesh/Inner Radius");
     if (m.cells[1] < 3) v.fail("Mesh/Cells", "an annulus needs at least 3 circumferential cells");
+    m.outerCellRatio = positive(mesh, "Outer Cell Ratio", v, "Mesh");
+    m.fineSector = three<double>(mesh, "Fine Sector", v, "Mesh");
+    const auto& fs = m.fineSector;
+    if (!std::isfinite(fs[0]) || !(fs[1] >= 0 && fs[1] < 360))
+      v.fail("Mesh/Fine Sector", "the centre must be finite and the width in [0, 360) degrees");
+    if (fs[1] > 0 && !(fs[2] > 0 && fs[2] < 1))
+      v.fail("Mesh/Fine Sector", "the fraction of cells in the sector must be in (0, 1)");
     m.min = {m.center[0] - m.outerRadius, m.center[1] - m.outerRadius, m.center[2]};
     m.max = {m.center[0] + m.outerRadius, m.center[1] + m.outerRadius, m.center[2] + m.length};
     nodes = double(m.cells[0] + 1.0) * m.cells[1] * (m.cells[2] + 1.0);

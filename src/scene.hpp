@@ -17,6 +17,8 @@ struct MeshSpec {
   // Annulus: axis point at the zmin end (axis along +z), radii, length.
   std::array<double, 3> center{};
   double innerRadius = 0, outerRadius = 0, length = 0;
+  double outerCellRatio = 1;             // radial grading (AnnulusGenerator)
+  std::array<double, 3> fineSector{};    // {centre deg, width deg, fraction of cells}
   std::vector<std::string> faceNames() const;
 };
 

@@ -1042,7 +1042,8 @@ int Run::execute() {
   if (!opt_.restart.empty()) openRestart(restart);
 
   if (m.type == "Annulus")
-    generator_ = std::make_unique<AnnulusGenerator>(m.center, m.innerRadius, m.outerRadius, m.length, m.cells);
+    generator_ = std::make_unique<AnnulusGenerator>(m.center, m.innerRadius, m.outerRadius, m.length, m.cells,
+                                                    m.outerCellRatio, m.fineSector);
   else
     generator_ = std::make_unique<BoxGenerator>(m.min, m.max, m.cells);
   mesh_ = distributeMesh(*generator_, comm_);

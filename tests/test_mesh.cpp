@@ -106,6 +106,52 @@ TEST(Annulus, BricksVolumeFacesAndNeighbours) {
   EXPECT_NE(std::find(last.begin(), last.end(), 0), last.end());
 }
 
+// Graded: radial thicknesses in geometric progression to the outer-cell ratio,
+// and the fine sector holding its share of the circumferential cells; still a
+// valid ring (positive Jacobians, the polygonal volume).
+TEST(Annulus, Grading) {
+  const double ri = 1.0, ro = 3.0, length = 0.5;
+  AnnulusGenerator gen({0, 0, 0}, ri, ro, length, {5, 40, 1}, 0.2, {-90, 30, 0.5});
+  std::vector<double> r(6);
+  for (int i = 0; i <= 5; ++i) r[i] = gen.nodeCoordinates(i)[0];  // j = 0, k = 0: along the start angle
+  const double c0 = std::cos(std::atan2(gen.nodeCoordinates(0)[1], gen.nodeCoordinates(0)[0]));
+  for (double& x : r) x /= c0;
+  EXPECT_NEAR(r[0], ri, 1e-12);
+  EXPECT_NEAR(r[5], ro, 1e-12);
+  EXPECT_NEAR((r[5] - r[4]) / (r[1] - r[0]), 0.2, 1e-12);
+  for (int i = 1; i < 4; ++i) EXPECT_NEAR((r[i + 1] - r[i]) / (r[i] - r[i - 1]), std::pow(0.2, 0.25), 1e-12);
+  // 20 of the 40 cells lie within -90 +- 15 degrees.
+  int inSector = 0;
+  double area = 0;
+  for (GO j = 0; j < 40; ++j) {
+    const auto a = gen.nodeCoordinates(6 * j), b = gen.nodeCoordinates(6 * ((j + 1) % 40));
+    const double ta = std::atan2(a[1], a[0]), tb = std::atan2(b[1], b[0]);
+    double mid = std::atan2(std::sin(ta) + std::sin(tb), std::cos(ta) + std::cos(tb)) * 180 / M_PI;
+    if (std::fabs(mid + 90) < 15) ++inSector;
+    double dt = tb - ta;
+    if (dt < 0) dt += 2 * M_PI;
+    area += 0.5 * std::sin(dt) * (ro * ro - ri * ri);
+  }
+  EXPECT_EQ(inSector, 20);
+  double volume = 0;
+  for (GO e = 0; e < gen.numElements(); ++e) {
+    double X[8][3];
+    const auto nodes = gen.elementNodes(e);
+    for (int a = 0; a < 8; ++a) {
+      const auto x = gen.nodeCoordinates(nodes[a]);
+      for (int i = 0; i < 3; ++i) X[a][i] = x[i];
+    }
+    for (int q = 0; q < 8; ++q) {
+      double D[8][3];
+      const double det = kernels::hexReferenceGradients(X, kernels::gauss2(q & 1), kernels::gauss2((q >> 1) & 1),
+                                                        kernels::gauss2(q >> 2), D);
+      ASSERT_GT(det, 0) << "element " << e;
+      volume += det;
+    }
+  }
+  EXPECT_NEAR(volume, area * length, 1e-10 * volume);
+}
+
 TEST(Annulus, DistributesWithFaces) {
   AnnulusGenerator gen({0, 0, 0}, 1.0, 2.0, 1.0, {2, 12, 2});
   const Mesh mesh = distributeMesh(gen, Tpetra::getDefaultComm());
