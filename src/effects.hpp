@@ -145,9 +145,7 @@ class BodyForceEffect : public Effect {
   void launch(const NodalVectors& x, const NodalVectors& u, bool tangent) override;
 
  private:
-  Kokkos::View<int* [8], Kokkos::LayoutRight> nodes_;
-  Kokkos::View<double* [8][3], Kokkos::LayoutRight> X_;
-  std::array<double, 3> b_;
+  Matrix fullLoad_;  // the nodal loads of b itself, integrated once (they never change)
   double endTime_, scale_ = 0;
 };
 

@@ -139,6 +139,15 @@ struct FieldWriter::Impl {
 
   // Layout checks shared by both constructors (collective).
   void init(const std::string& directory, const FieldLayout& layout);
+  // File-access properties for parallel (MPI-IO) HDF5; the caller closes them.
+  hid_t mpioFileAccess() const {
+    const hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+    if (fapl < 0 || H5Pset_fapl_mpio(fapl, comm, MPI_INFO_NULL) < 0) {
+      if (fapl >= 0) H5Pclose(fapl);
+      check(false, "cannot set up the MPI-IO file driver");
+    }
+    return fapl;
+  }
 
   // Names of the links in group `path`, in name order.
   std::vector<std::string> children(const std::string& path) const {
@@ -264,9 +273,7 @@ FieldWriter::FieldWriter(const std::string& directory, const FieldLayout& l) : i
   Impl& m = *impl_;
   try {
     m.init(directory, l);
-    Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
-    m.check(fapl >= 0 && H5Pset_fapl_mpio(fapl, m.comm, MPI_INFO_NULL) >= 0,
-            "cannot set up the MPI-IO file driver");
+    Handle fapl(m.mpioFileAccess(), H5Pclose);
     m.file = H5Fcreate(m.h5Path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
     m.check(m.file >= 0, "cannot create file (does the directory exist?)");
 
@@ -290,9 +297,7 @@ FieldWriter::FieldWriter(const std::string& directory, const FieldLayout& l, App
   Impl& m = *impl_;
   try {
     m.init(directory, l);
-    Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
-    m.check(fapl >= 0 && H5Pset_fapl_mpio(fapl, m.comm, MPI_INFO_NULL) >= 0,
-            "cannot set up the MPI-IO file driver");
+    Handle fapl(m.mpioFileAccess(), H5Pclose);
     // Every rank learns whether the file opened, so none is left in a collective call.
     m.file = H5Fopen(m.h5Path.c_str(), H5F_ACC_RDWR, fapl);
     agree(m.comm, m.file >= 0 ? "" : "FieldWriter: " + m.h5Path + ": cannot open for appending");

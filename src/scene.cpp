@@ -624,6 +624,23 @@ void applyAccuracyPreset(ParameterList& user, const Validator& v) {
 
 }  // namespace
 
+// A mesh parameter of the other mesh type would be silently ignored: most likely
+// a forgotten or misspelled Mesh/Type, so it is an error. Checked on the user's
+// list, before defaults fill in every parameter of both types.
+static void rejectOtherMeshTypeParameters(const ParameterList& user, const Validator& v) {
+  if (!user.isSublist("Mesh")) return;
+  const auto& mesh = user.sublist("Mesh");
+  const std::string type = mesh.isType<std::string>("Type") ? mesh.get<std::string>("Type") : "Box";
+  const std::vector<std::string> boxOnly = {"Min", "Max"};
+  const std::vector<std::string> annulusOnly = {"Center", "Inner Radius", "Outer Radius", "Length",
+                                                "Outer Cell Ratio", "Fine Sector"};
+  const auto& other = type == "Annulus" ? boxOnly : type == "Box" ? annulusOnly : std::vector<std::string>{};
+  for (const auto& name : other)
+    if (mesh.isParameter(name))
+      v.fail("Mesh/" + name, "is not a parameter of Mesh/Type = " + type + " (it belongs to " +
+                                 (type == "Box" ? "Annulus" : "Box") + ")");
+}
+
 std::vector<std::string> MeshSpec::faceNames() const {
   if (type == "Annulus") return {"inner", "outer", "zmin", "zmax"};
   return {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
@@ -653,6 +670,7 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
   for (const auto& s : sets) applySet(*user, valid, file, s);
   if (!outputOverride.empty()) user->sublist("Output").set("Directory", outputOverride);
   applyAccuracyPreset(*user, v);
+  rejectOtherMeshTypeParameters(*user, v);
   v.check(*user, valid, "");
 
   Scene sc;

@@ -484,6 +484,12 @@ TEST_F(SceneTest, AccuracyPresets) {
   expectInputError(file, {"'Accuracy'", "'Coarse' is not an accuracy preset"}, {"Accuracy=Coarse"});
 }
 
+TEST_F(SceneTest, MeshParametersOfTheOtherType) {
+  const std::string file = write(SceneText().str());
+  expectInputError(file, {"'Mesh/Inner Radius'", "Mesh/Type = Box"}, {"Mesh/Inner Radius=2"});
+  expectInputError(file, {"'Mesh/Min'", "Mesh/Type = Annulus"}, {"Mesh/Type=Annulus"});
+}
+
 TEST_F(SceneTest, BodyForce) {
   const std::string file = write(SceneText().str());
   EXPECT_EQ(loadScene(file, {}, "").bodyForce, (std::array<double, 3>{0, 0, 0}));
