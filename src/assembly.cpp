@@ -23,7 +23,23 @@ Assembly::Assembly(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
                                               scene.solver.get<double>("Volume Tolerance"));
   bricks_ = bricks.get();
   effects_.push_back(std::move(bricks));
-  const size_t ndof = 3 * mesh.numOverlapNodes();
+  nodeDofs_ = int(3 * mesh.numOverlapNodes());
+  // Rigid cores first: their face nodes follow the core whatever other
+  // support also names them.
+  coreOfNode_.assign(mesh.numOverlapNodes(), -1);
+  for (const auto& s : scene.supports) {
+    if (s.type != "Rigid Core") continue;
+    RigidCore core;
+    core.name = s.name;
+    core.axisPoint = s.axisPoint, core.axisDirection = s.axisDirection, core.force = s.force;
+    core.torque = s.torque, core.rampTime = s.rampTime;
+    core.free = {s.freeTranslation[0], s.freeTranslation[1], s.freeTranslation[2], s.rotation == "Free"};
+    core.firstDof = nodeDofs_ + 6 * int(cores_.size());
+    for (int n : mesh.faceNodes(s.face))
+      if (coreOfNode_[n] < 0) coreOfNode_[n] = int(cores_.size());
+    cores_.push_back(core);
+  }
+  const size_t ndof = size_t(nodeDofs_) + 6 * cores_.size();
   constraints_.supportOf.assign(ndof, -1);
   constraints_.velocity.assign(ndof, 0.0);
   for (const auto& s : scene.supports) {
@@ -34,10 +50,23 @@ Assembly::Assembly(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
       effects_.push_back(std::move(f));
       continue;
     }
-    // Fixed, Roller, Displacement: the first support in the scene that holds a
-    // dof owns it (and its reaction).
     const int id = int(constraints_.supportNames.size());
     constraints_.supportNames.push_back(s.name);
+    if (s.type == "Rigid Core") {
+      auto& core = *std::find_if(cores_.begin(), cores_.end(), [&](const RigidCore& c) { return c.name == s.name; });
+      core.support = id;
+      for (size_t n = 0; n < coreOfNode_.size(); ++n)
+        if (coreOfNode_[n] == int(&core - cores_.data()))
+          for (int i = 0; i < 3; ++i) constraints_.supportOf[3 * n + i] = id;
+      for (int j = 0; j < 6; ++j) {
+        if (j < 4 && core.free[j]) continue;  // an unknown of the Newton solve
+        constraints_.supportOf[core.firstDof + j] = id;
+        constraints_.velocity[core.firstDof + j] = j == 3 && s.rotation == "Prescribed" ? s.angularVelocity : 0.0;
+      }
+      continue;
+    }
+    // Fixed, Roller, Displacement: the first support in the scene that holds a
+    // dof owns it (and its reaction).
     for (int n : mesh.faceNodes(s.face))
       for (int i = 0; i < 3; ++i) {
         if (!s.components[i] || constraints_.supportOf[3 * n + i] >= 0) continue;
@@ -99,26 +128,73 @@ Assembly::Assembly(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
     effects_.push_back(std::move(friction));
   }
 
-  // Graph from every effect's entities: built once, fixed sparsity.
-  importer_ = rcp(new Tpetra::Import<>(mesh.ownedDofMap, mesh.overlapDofMap));
+  // Graph from every effect's entities: built once, fixed sparsity. An entity
+  // with a core's face node also couples to the core's free unknowns.
+  buildDofMaps();
+  importer_ = rcp(new Tpetra::Import<>(ownedDofMap_, overlapDofMap_));
   // Global column ids: the owner of a shared row also receives columns that only
   // other ranks' elements touch, so the column map is built by Tpetra after the
   // export, not taken from this rank's nodes.
-  graph_ = rcp(new FEGraph(mesh.ownedDofMap, mesh.overlapDofMap, 81, importer_));
+  const auto& overlap = *overlapDofMap_;
+  auto gid = [&](int dof) { return overlap.getGlobalElement(overlapLid(dof)); };
+  if (cores_.empty()) {
+    graph_ = rcp(new FEGraph(ownedDofMap_, overlapDofMap_, 81, importer_));
+  } else {
+    // A node's row has at most 81 entries (27 nodes), plus a core's 4 unknowns;
+    // a core's rows have one entry per dof of the elements at its face.
+    Kokkos::DualView<size_t*, FEGraph::device_type> perRow("entries per row", overlap.getNodeNumElements());
+    auto h = perRow.view_host();
+    Kokkos::deep_copy(h, size_t(81 + 4 * cores_.size()));
+    std::vector<std::vector<char>> seen(cores_.size(), std::vector<char>(constraints_.supportOf.size(), 0));
+    for (const auto& effect : effects_) {
+      if (effect->local().K.extent(0) == 0) continue;
+      auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), effect->local().dofs);
+      for (size_t e = 0; e < dofs.extent(0); ++e)
+        for (size_t k = 0; k < dofs.extent(1); ++k) {
+          const int c = coreOfNode_[dofs(e, k) / 3];
+          if (c >= 0)
+            for (size_t l = 0; l < dofs.extent(1); ++l) seen[c][dofs(e, l)] = 1;
+        }
+    }
+    for (size_t c = 0; c < cores_.size(); ++c) {
+      const size_t count = std::count(seen[c].begin(), seen[c].end(), char(1)) + 6 * cores_.size();
+      for (int j = 0; j < 6; ++j) h(overlapLid(cores_[c].firstDof + j)) = count;
+    }
+    perRow.modify_host();
+    perRow.sync_device();
+    graph_ = rcp(new FEGraph(ownedDofMap_, overlapDofMap_, perRow, importer_));
+  }
   graph_->beginAssembly();
-  const auto& overlap = *mesh.overlapDofMap;
   for (const auto& effect : effects_) {
+    coupled_.emplace_back();
     if (effect->local().K.extent(0) == 0) continue;  // no stiffness, no graph entries
     auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), effect->local().dofs);
-    std::vector<GO> cols(dofs.extent(1));
+    std::vector<GO> cols;
     for (size_t e = 0; e < dofs.extent(0); ++e) {
-      for (size_t k = 0; k < cols.size(); ++k) cols[k] = overlap.getGlobalElement(dofs(e, k));
+      cols.clear();
+      std::set<int> cores;
+      for (size_t k = 0; k < dofs.extent(1); ++k) {
+        cols.push_back(gid(dofs(e, k)));
+        if (coreOfNode_[dofs(e, k) / 3] >= 0) cores.insert(coreOfNode_[dofs(e, k) / 3]);
+      }
+      for (int c : cores)
+        for (int j = 0; j < 4; ++j)
+          if (cores_[c].free[j]) cols.push_back(gid(cores_[c].firstDof + j));
+      if (!cores.empty()) coupled_.back().push_back(int(e));
       for (GO row : cols) graph_->insertGlobalIndices(row, Teuchos::ArrayView<const GO>(cols));
     }
   }
+  if (coresOwned_)  // the cores' held dofs get their unit diagonal
+    for (const auto& core : cores_)
+      for (int j = 0; j < 6; ++j) {
+        const GO g = gid(core.firstDof + j);
+        graph_->insertGlobalIndices(g, Teuchos::ArrayView<const GO>(&g, 1));
+      }
   graph_->endAssembly();
   // Each effect's dofs as local column ids of the assembled matrix.
   const auto& colMap = *graph_->getColMap();
+  columnOf_.resize(constraints_.supportOf.size());
+  for (size_t d = 0; d < columnOf_.size(); ++d) columnOf_[d] = colMap.getLocalElement(gid(int(d)));
   for (const auto& effect : effects_) {
     if (effect->local().K.extent(0) == 0) {
       columns_.emplace_back();
@@ -127,15 +203,94 @@ Assembly::Assembly(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
     auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), effect->local().dofs);
     std::vector<LO> cols(dofs.size());
     for (size_t e = 0; e < dofs.extent(0); ++e)
-      for (size_t k = 0; k < dofs.extent(1); ++k)
-        cols[e * dofs.extent(1) + k] = colMap.getLocalElement(overlap.getGlobalElement(dofs(e, k)));
+      for (size_t k = 0; k < dofs.extent(1); ++k) cols[e * dofs.extent(1) + k] = columnOf_[dofs(e, k)];
     columns_.push_back(std::move(cols));
   }
   findEntryOffsets();
-  uOverlap_ = rcp(new Vector(mesh.overlapDofMap));
-  residual_ = rcp(new Tpetra::FEMultiVector<>(mesh.ownedDofMap, importer_, 1));
+  uOverlap_ = rcp(new Vector(overlapDofMap_));
+  residual_ = rcp(new Tpetra::FEMultiVector<>(ownedDofMap_, importer_, 1));
   x_ = NodalVectors("x", mesh.numOverlapNodes());
   u_ = NodalVectors("u", mesh.numOverlapNodes());
+  readCores(uOverlap_->getData());  // the undeformed state until the first evaluation
+}
+
+void Assembly::assembleCoreCoupling(FEMatrix& W) {
+  if (cores_.empty()) return;
+  // The chain rule for u_s = T + (R(theta) - I)(X_s - A) at each face node s,
+  // with B_s = du_s/dq = [I | b_s]: element entries K(k, s) go to K(k, q) B_s,
+  // K(s, l) to B_s^T K(s, l), K(s, s') to B_s^T K B_s'; and
+  // d(sum_s R_s . b_s)/dtheta adds sum_s R_s . w_s to (theta, theta).
+  // Accumulated per element in dense arrays, then added row by row.
+  const auto& supportOf = constraints_.supportOf;
+  const size_t nc = cores_.size(), nq = 4 * nc;
+  std::vector<double> toCore(nq * nodeDofs_, 0.0), fromCore(nq * nodeDofs_, 0.0), coreCore(nq * nq, 0.0);
+  std::vector<char> touched(nodeDofs_, 0);
+  for (size_t i = 0; i < effects_.size(); ++i) {
+    const auto& L = effects_[i]->local();
+    if (L.K.extent(0) == 0 || coupled_[i].empty()) continue;
+    const auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.dofs);
+    const auto K = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.K);
+    const auto active = activeOnHost(L);
+    const int n = int(dofs.extent(1));
+    std::vector<std::array<double, 4>> B(n);
+    std::vector<int> coreOf(n);
+    for (int e : coupled_[i]) {
+      if (active.size() && !active(e)) continue;
+      for (int k = 0; k < n; ++k) {
+        const int d = dofs(e, k), c = coreOfNode_[d / 3];
+        coreOf[k] = c;
+        if (c >= 0) B[k] = {d % 3 == 0 ? 1.0 : 0.0, d % 3 == 1 ? 1.0 : 0.0, d % 3 == 2 ? 1.0 : 0.0, followers_[d / 3].b[d % 3]};
+      }
+      for (int k = 0; k < n; ++k)
+        for (int l = 0; l < n; ++l) {
+          const int ck = coreOf[k], cl = coreOf[l], dk = dofs(e, k), dl = dofs(e, l);
+          const double Kkl = K(e, k, l);
+          if ((ck < 0 && cl < 0) || Kkl == 0) continue;
+          if (ck < 0) {
+            if (supportOf[dk] >= 0) continue;
+            touched[dk] = 1;
+            for (int j = 0; j < 4; ++j) toCore[(4 * cl + j) * nodeDofs_ + dk] += Kkl * B[l][j];
+          } else if (cl < 0) {
+            if (supportOf[dl] >= 0) continue;
+            touched[dl] = 1;
+            for (int j = 0; j < 4; ++j) fromCore[(4 * ck + j) * nodeDofs_ + dl] += B[k][j] * Kkl;
+          } else {
+            for (int a = 0; a < 4; ++a)
+              for (int b = 0; b < 4; ++b) coreCore[(4 * ck + a) * nq + 4 * cl + b] += B[k][a] * Kkl * B[l][b];
+          }
+        }
+    }
+  }
+  std::vector<LO> cols;
+  std::vector<double> vals;
+  auto add = [&](LO row) {
+    const LO added = W.sumIntoLocalValues(row, Teuchos::ArrayView<const LO>(cols), Teuchos::ArrayView<const double>(vals));
+    if (added != LO(cols.size())) throw std::logic_error("assembly: a rigid-core entry is missing from the matrix graph");
+  };
+  auto freeCoreDof = [&](size_t q) { return cores_[q / 4].free[q % 4]; };
+  auto coreDof = [&](size_t q) { return cores_[q / 4].firstDof + int(q % 4); };
+  for (int d = 0; d < nodeDofs_; ++d) {
+    if (!touched[d]) continue;
+    cols.clear(), vals.clear();
+    for (size_t q = 0; q < nq; ++q)
+      if (freeCoreDof(q) && toCore[q * nodeDofs_ + d] != 0)
+        cols.push_back(columnOf_[coreDof(q)]), vals.push_back(toCore[q * nodeDofs_ + d]);
+    if (!cols.empty()) add(overlapLid(d));
+  }
+  for (size_t q = 0; q < nq; ++q) {
+    if (!freeCoreDof(q)) continue;
+    cols.clear(), vals.clear();
+    for (int d = 0; d < nodeDofs_; ++d)
+      if (touched[d] && fromCore[q * nodeDofs_ + d] != 0)
+        cols.push_back(columnOf_[d]), vals.push_back(fromCore[q * nodeDofs_ + d]);
+    for (size_t p = 0; p < nq; ++p) {
+      double v = coreCore[q * nq + p];
+      // The reactions are global sums: rank 0 adds the geometric term once.
+      if (p == q && q % 4 == 3 && coresOwned_) v += cores_[q / 4].geometric;
+      if (freeCoreDof(p) && v != 0) cols.push_back(columnOf_[coreDof(p)]), vals.push_back(v);
+    }
+    if (!cols.empty()) add(overlapLid(coreDof(q)));
+  }
 }
 
 void Assembly::findEntryOffsets() {
@@ -167,15 +322,13 @@ void Assembly::findEntryOffsets() {
         for (size_t l = 0; l < n; ++l)
           h(e, k, l) = supportOf[dofs(e, k)] >= 0 || supportOf[dofs(e, l)] >= 0
                            ? -1
-                           : find(dofs(e, k), columns_[i][e * n + l]);
+                           : find(overlapLid(dofs(e, k)), columns_[i][e * n + l]);
     Kokkos::deep_copy(offsets, h);
     entryOffsets_.push_back(offsets);
   }
-  const auto& colMap = *W->getColMap();
-  const auto& overlap = *mesh_.overlapDofMap;
   std::vector<long> diagonal;
-  for (LO d = 0; d < LO(3 * mesh_.numOwnedNodes); ++d)
-    if (supportOf[d] >= 0) diagonal.push_back(find(d, colMap.getLocalElement(overlap.getGlobalElement(d))));
+  for (LO d = 0; d < LO(ownedDofMap_->getNodeNumElements()); ++d)
+    if (supportOf[assemblyDof(d)] >= 0) diagonal.push_back(find(d, columnOf_[assemblyDof(d)]));
   constrainedDiagonal_ = Kokkos::View<long*>("constrained diagonal", diagonal.size());
   auto hd = Kokkos::create_mirror_view(constrainedDiagonal_);
   for (size_t j = 0; j < diagonal.size(); ++j) hd(j) = diagonal[j];
@@ -185,10 +338,83 @@ void Assembly::findEntryOffsets() {
 
 RCP<FEMatrix> Assembly::createMatrix() const { return rcp(new FEMatrix(graph_)); }
 
-void Assembly::applyConstraints(Vector& u, double t) const {
+LO Assembly::overlapLid(int dof) const {
+  const int ownedNodeDofs = int(3 * mesh_.numOwnedNodes);
+  if (dof >= nodeDofs_) return LO(coresOwned_ ? ownedNodeDofs + (dof - nodeDofs_) : dof);
+  return LO(coresOwned_ && dof >= ownedNodeDofs ? dof + int(6 * cores_.size()) : dof);
+}
+
+void Assembly::buildDofMaps() {
+  coresOwned_ = !cores_.empty() && mesh_.comm->getRank() == 0;
+  if (cores_.empty()) {
+    ownedDofMap_ = mesh_.ownedDofMap, overlapDofMap_ = mesh_.overlapDofMap;
+    return;
+  }
+  const GO firstCoreGid = GO(3 * mesh_.numGlobalNodes);
+  auto gid = [&](int d) { return d < nodeDofs_ ? 3 * mesh_.nodeGids[d / 3] + d % 3 : firstCoreGid + (d - nodeDofs_); };
+  const int ndof = int(constraints_.supportOf.size());
+  std::vector<GO> owned, overlap(ndof);
+  for (int d = 0; d < int(3 * mesh_.numOwnedNodes); ++d) owned.push_back(gid(d));
+  if (coresOwned_)
+    for (int d = nodeDofs_; d < ndof; ++d) owned.push_back(gid(d));
+  for (int d = 0; d < ndof; ++d) overlap[overlapLid(d)] = gid(d);
+  const auto invalid = Teuchos::OrdinalTraits<Tpetra::global_size_t>::invalid();
+  ownedDofMap_ = rcp(new Map(invalid, Teuchos::ArrayView<const GO>(owned), 0, mesh_.comm));
+  overlapDofMap_ = rcp(new Map(invalid, Teuchos::ArrayView<const GO>(overlap), 0, mesh_.comm));
+}
+
+void Assembly::readCores(const Teuchos::ArrayRCP<const double>& ud) {
+  for (auto& core : cores_) {
+    for (int i = 0; i < 3; ++i) core.translation[i] = ud[overlapLid(core.firstDof + i)];
+    core.rotation = ud[overlapLid(core.firstDof + 3)];
+  }
+  followers_.resize(mesh_.numOverlapNodes());
+  for (size_t n = 0; n < coreOfNode_.size(); ++n) {
+    if (coreOfNode_[n] < 0) continue;
+    const auto& core = cores_[coreOfNode_[n]];
+    followers_[n] = kernels::coreFollower(core.axisPoint.data(), core.axisDirection.data(), core.translation.data(),
+                                          core.rotation, &mesh_.X[3 * n]);
+  }
+}
+
+std::vector<std::array<double, 5>> Assembly::coreSums(const Teuchos::ArrayRCP<const double>& v) const {
+  const size_t nc = cores_.size();
+  std::vector<double> local(5 * nc, 0.0), global(5 * nc, 0.0);
+  for (size_t n = 0; n < mesh_.numOwnedNodes; ++n) {
+    const int c = coreOfNode_[n];
+    if (c < 0) continue;
+    for (int i = 0; i < 3; ++i) {
+      const double r = v[3 * n + i];
+      local[5 * c + i] += r;
+      local[5 * c + 3] += r * followers_[n].b[i];
+      local[5 * c + 4] += r * followers_[n].w[i];
+    }
+  }
+  if (nc) Teuchos::reduceAll(*mesh_.comm, Teuchos::REDUCE_SUM, int(5 * nc), local.data(), global.data());
+  std::vector<std::array<double, 5>> out(nc);
+  for (size_t c = 0; c < nc; ++c)
+    for (int k = 0; k < 5; ++k) out[c][k] = global[5 * c + k];
+  return out;
+}
+
+void Assembly::applyConstraints(Vector& u, double t) {
+  const auto& supportOf = constraints_.supportOf;
+  {
+    auto data = u.getDataNonConst();
+    for (LO d = 0; d < LO(data.size()); ++d) {
+      const int a = assemblyDof(d);
+      const bool follows = a < nodeDofs_ && coreOfNode_[a / 3] >= 0;
+      if (supportOf[a] >= 0 && !follows) data[d] = constraints_.velocity[a] * t;
+    }
+  }
+  if (cores_.empty()) return;
+  // The face nodes follow the cores' values, which rank 0 owns.
+  uOverlap_->doImport(u, *importer_, Tpetra::INSERT);
+  readCores(uOverlap_->getData());
   auto data = u.getDataNonConst();
-  for (LO d = 0; d < LO(data.size()); ++d)
-    if (constraints_.supportOf[d] >= 0) data[d] = constraints_.velocity[d] * t;
+  for (size_t n = 0; n < mesh_.numOwnedNodes; ++n)
+    if (coreOfNode_[n] >= 0)
+      for (int i = 0; i < 3; ++i) data[3 * n + i] = followers_[n].u[i];
 }
 
 bool Assembly::evaluate(const Vector& u, Vector* f, FEMatrix* W) {
@@ -196,12 +422,14 @@ bool Assembly::evaluate(const Vector& u, Vector* f, FEMatrix* W) {
   uOverlap_->doImport(u, *importer_, Tpetra::INSERT);
   {
     auto ud = uOverlap_->getData();
+    readCores(ud);
     auto hx = Kokkos::create_mirror_view(x_);
     auto hu = Kokkos::create_mirror_view(u_);
     for (size_t n = 0; n < mesh_.numOverlapNodes(); ++n)
       for (int i = 0; i < 3; ++i) {
-        hu(n, i) = ud[3 * n + i];
-        hx(n, i) = mesh_.X[3 * n + i] + ud[3 * n + i];
+        // A core's face node sits where the core puts it, whatever u holds there.
+        hu(n, i) = coreOfNode_[n] >= 0 ? followers_[n].u[i] : ud[overlapLid(int(3 * n + i))];
+        hx(n, i) = mesh_.X[3 * n + i] + hu(n, i);
       }
     Kokkos::deep_copy(x_, hx);
     Kokkos::deep_copy(u_, hu);
@@ -220,15 +448,37 @@ bool Assembly::evaluate(const Vector& u, Vector* f, FEMatrix* W) {
   const bool valid = globalMinJ > 0 && std::isfinite(globalMinJ);
   const auto& supportOf = constraints_.supportOf;
 
-  if (f) {
+  // The residual; with rigid cores also for the tangent alone, whose
+  // theta-theta entry needs the reactions at the face nodes.
+  if (f || (W && !cores_.empty())) {
     std::vector<Matrix> R;
     for (const auto& effect : effects_) R.push_back(effect->local().R);
     sumEntityVectors(R);
     auto ro = residual_->getData(0);
     rawOwnedResidual_.assign(ro.begin(), ro.end());
-    auto out = f->getDataNonConst();
-    for (LO d = 0; d < LO(out.size()); ++d)
-      out[d] = !valid ? 1e150 : supportOf[d] >= 0 ? 0.0 : ro[d];
+    const auto sums = coreSums(ro);
+    for (size_t c = 0; c < cores_.size(); ++c) {
+      for (int i = 0; i < 3; ++i) cores_[c].forceOnBody[i] = sums[c][i];
+      cores_[c].torqueOnBody = sums[c][3];
+      cores_[c].geometric = sums[c][4];
+    }
+    if (f) {
+      auto out = f->getDataNonConst();
+      for (LO d = 0; d < LO(out.size()); ++d) {
+        const int a = assemblyDof(d);
+        if (!valid) out[d] = 1e150;
+        else if (supportOf[a] >= 0) out[d] = 0.0;
+        else if (a < nodeDofs_) out[d] = ro[d];
+        else {
+          // A core's free unknown: the reactions it exerts on the body balance
+          // the external load on it.
+          const auto& core = cores_[(a - nodeDofs_) / 6];
+          const int j = (a - nodeDofs_) % 6;
+          const double load = core.loadFactor(time_);
+          out[d] = j < 3 ? core.forceOnBody[j] - load * core.force[j] : core.torqueOnBody - load * core.torque;
+        }
+      }
+    }
   }
 
   if (W) {
@@ -259,6 +509,7 @@ bool Assembly::evaluate(const Vector& u, Vector* f, FEMatrix* W) {
         "constrained diagonal", Kokkos::RangePolicy<ExecSpace>(0, diagonal.extent(0)),
         KOKKOS_LAMBDA(int j) { values(diagonal(j)) = 1.0; });
     Kokkos::fence();
+    assembleCoreCoupling(*W);
     W->endAssembly();
   }
   assemblySeconds_ += timer.seconds();
@@ -276,7 +527,7 @@ void Assembly::sumEntityVectors(const std::vector<Matrix>& values) {
       auto active = activeOnHost(effects_[i]->local());
       for (size_t e = 0; e < dofs.extent(0); ++e)
         if (!active.size() || active(e))
-          for (size_t k = 0; k < dofs.extent(1); ++k) r[dofs(e, k)] += v(e, k);
+          for (size_t k = 0; k < dofs.extent(1); ++k) r[overlapLid(dofs(e, k))] += v(e, k);
     }
   }
   residual_->endAssembly();  // one export: shared rows added into their owners
@@ -301,7 +552,7 @@ void Assembly::tangentAction(const Vector& z, Vector& y) {
           ho(e, k) = 0;
           continue;
         }
-        for (size_t l = 0; l < dofs.extent(1); ++l) s += K(e, k, l) * zd[dofs(e, l)];
+        for (size_t l = 0; l < dofs.extent(1); ++l) s += K(e, k, l) * zd[overlapLid(dofs(e, l))];
         ho(e, k) = s;
       }
     Kokkos::deep_copy(out, ho);
@@ -309,21 +560,40 @@ void Assembly::tangentAction(const Vector& z, Vector& y) {
   }
   sumEntityVectors(Kz);
   auto ro = residual_->getData(0);
+  const auto sums = coreSums(ro);  // K z at the face nodes, carried to the cores' unknowns
   auto yd = y.getDataNonConst();
-  for (LO d = 0; d < LO(yd.size()); ++d) yd[d] = ro[d];
+  for (LO d = 0; d < LO(yd.size()); ++d) {
+    const int a = assemblyDof(d);
+    yd[d] = a < nodeDofs_ ? ro[d] : (a - nodeDofs_) % 6 < 4 ? sums[(a - nodeDofs_) / 6][(a - nodeDofs_) % 6] : 0.0;
+  }
 }
 
 void Assembly::constraintIncrement(Vector& z, double t0, double t1) const {
   auto data = z.getDataNonConst();
-  for (LO d = 0; d < LO(data.size()); ++d)
-    data[d] = constraints_.supportOf[d] >= 0 ? constraints_.velocity[d] * (t1 - t0) : 0.0;
+  const auto& supportOf = constraints_.supportOf;
+  const auto& velocity = constraints_.velocity;
+  for (LO d = 0; d < LO(data.size()); ++d) {
+    const int a = assemblyDof(d);
+    if (a < nodeDofs_ && coreOfNode_[a / 3] >= 0) {
+      // Linearised at the cores' last state: dT + b dtheta, held parts only.
+      const auto& core = cores_[coreOfNode_[a / 3]];
+      const int i = a % 3;
+      const double dT = supportOf[core.firstDof + i] >= 0 ? velocity[core.firstDof + i] * (t1 - t0) : 0.0;
+      const double dTheta = supportOf[core.firstDof + 3] >= 0 ? velocity[core.firstDof + 3] * (t1 - t0) : 0.0;
+      data[d] = dT + followers_[a / 3].b[i] * dTheta;
+    } else {
+      data[d] = supportOf[a] >= 0 ? velocity[a] * (t1 - t0) : 0.0;
+    }
+  }
 }
 
 std::vector<std::array<double, 3>> Assembly::constraintReactions() const {
   const size_t ns = constraints_.supportNames.size();
   std::vector<double> local(3 * ns, 0.0), global(3 * ns, 0.0);
-  for (size_t d = 0; d < rawOwnedResidual_.size(); ++d)
-    if (constraints_.supportOf[d] >= 0) local[3 * constraints_.supportOf[d] + d % 3] += rawOwnedResidual_[d];
+  for (size_t d = 0; d < rawOwnedResidual_.size(); ++d) {
+    const int a = assemblyDof(LO(d));
+    if (constraints_.supportOf[a] >= 0) local[3 * constraints_.supportOf[a] + a % 3] += rawOwnedResidual_[d];
+  }
   if (ns)
     Teuchos::reduceAll(*mesh_.comm, Teuchos::REDUCE_SUM, int(3 * ns), local.data(), global.data());
   std::vector<std::array<double, 3>> out(ns);

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "../kernels/rigid_core.hpp"
 #include "effects.hpp"
 #include "mesh.hpp"
 #include "scene.hpp"
@@ -28,11 +29,36 @@ using CrsMatrix = Tpetra::CrsMatrix<>;
 using FEMatrix = Tpetra::FECrsMatrix<>;
 using FEGraph = Tpetra::FECrsGraph<>;
 
-// Dofs held by Fixed, Roller and Displacement supports: u = velocity * t.
+// Dofs held by Fixed, Roller and Displacement supports (u = velocity * t), and
+// by rigid cores: their face's nodes follow the core, and the core's held
+// components (translation, rotation, unused slots) are fixed or prescribed.
+// Indexed by "assembly dof": 3 * overlapped node + component, then 6 per rigid
+// core (Tx Ty Tz theta and two unused slots, so the dofs stay in blocks of 3).
 struct Constraints {
   std::vector<std::string> supportNames;  // index = support id
-  std::vector<int> supportOf;             // per overlapped dof: support id or -1
-  std::vector<double> velocity;           // per overlapped dof
+  std::vector<int> supportOf;             // per assembly dof: support id or -1
+  std::vector<double> velocity;           // per assembly dof
+};
+
+// A rigid core (SupportSpec type Rigid Core) as the assembly keeps it: its
+// unknowns q = (T, theta) are global dofs owned by rank 0; its face's nodes
+// are eliminated (u = T + (R(theta) - I)(X - A), kernels/rigid_core.hpp).
+struct RigidCore {
+  std::string name;
+  std::array<double, 3> axisPoint{}, axisDirection{}, force{};
+  double torque = 0, rampTime = 1;
+  std::array<bool, 4> free{};  // Tx Ty Tz theta
+  int support = -1;            // its support id in Constraints
+  int firstDof = 0;            // assembly dof of Tx
+  // At the last evaluation (global): q, and the force and torque of the core
+  // on the body (the reactions at its face's nodes).
+  std::array<double, 3> translation{};
+  double rotation = 0;
+  std::array<double, 3> forceOnBody{};
+  double torqueOnBody = 0;
+  double geometric = 0;  // sum over the face's nodes of R . w (the theta-theta tangent term)
+  // External loads at time t: ramped linearly to rampTime, then held.
+  double loadFactor(double t) const { return std::min(1.0, t / rampTime); }
 };
 
 class Assembly {
@@ -40,7 +66,16 @@ class Assembly {
   Assembly(const Mesh& mesh, const Scene& scene);
 
   const Mesh& mesh() const { return mesh_; }
-  RCP<const Map> dofMap() const { return mesh_.ownedDofMap; }
+  // Owned dofs: the owned nodes' (3 each, in node order), then on rank 0 the
+  // rigid cores' (6 each).
+  RCP<const Map> dofMap() const { return ownedDofMap_; }
+  // Whether the dof with this local id in dofMap() is held (a constrained row).
+  bool ownedConstrained(LO d) const { return constraints_.supportOf[assemblyDof(d)] >= 0; }
+  const std::vector<RigidCore>& rigidCores() const { return cores_; }
+  // Local id in dofMap() of a rigid core's dof j (0..5) on rank 0, -1 elsewhere.
+  LO ownedCoreDof(size_t core, int j) const {
+    return coresOwned_ ? LO(3 * mesh_.numOwnedNodes + 6 * core + j) : -1;
+  }
   RCP<FEMatrix> createMatrix() const;
   const Constraints& constraints() const { return constraints_; }
   BrickEffect& bricks() { return *bricks_; }
@@ -56,11 +91,13 @@ class Assembly {
 
   // The increment being solved (effects that move with time evaluate at tEnd).
   void setInterval(double tStart, double tEnd) {
+    time_ = tEnd;
     for (auto& e : effects_) e->setInterval(tStart, tEnd);
   }
 
-  // Sets the constrained entries of u to their values at time t.
-  void applyConstraints(Vector& u, double t) const;
+  // Sets the constrained entries of u to their values at time t, and the rigid
+  // cores' face nodes to where the cores' values in u put them.
+  void applyConstraints(Vector& u, double t);
 
   // Runs every effect at displacement u and assembles the residual f (if not
   // null) and the tangent W (if not null). Constrained rows: f = 0 and W has the
@@ -86,8 +123,34 @@ class Assembly {
  private:
   void sumEntityVectors(const std::vector<Matrix>& values);  // into residual_ (owned)
   void findEntryOffsets();
+  // Assembly dofs <-> local ids of the Tpetra maps. Overlapped order: owned
+  // node dofs, (rank 0) the cores' dofs, ghost node dofs, (other ranks) the
+  // cores' dofs: Tpetra's finite-element objects need the owned ids first.
+  LO overlapLid(int dof) const;
+  int assemblyDof(LO ownedLid) const {
+    const LO ownedNodeDofs = LO(3 * mesh_.numOwnedNodes);
+    return ownedLid < ownedNodeDofs ? int(ownedLid) : nodeDofs_ + int(ownedLid - ownedNodeDofs);
+  }
+  void buildDofMaps();
+  // The cores' q from the overlapped u, and each face node's follower data.
+  void readCores(const Teuchos::ArrayRCP<const double>& uOverlap);
+  // Sums over the owned core nodes of v (owned values, a residual or K z): per
+  // core {force (3), torque, R . w}, global.
+  std::vector<std::array<double, 5>> coreSums(const Teuchos::ArrayRCP<const double>& v) const;
+  // The chain rule at the cores' face nodes: element-matrix entries that touch
+  // a face node, carried to the core's free unknowns.
+  void assembleCoreCoupling(FEMatrix& W);
 
   const Mesh& mesh_;
+  int nodeDofs_ = 0;                    // 3 x overlapped nodes: the first core dof
+  std::vector<RigidCore> cores_;
+  std::vector<int> coreOfNode_;         // per overlapped node: its rigid core or -1
+  std::vector<kernels::CoreFollower> followers_;  // per overlapped node, at the cores' last q
+  bool coresOwned_ = false;             // this rank owns the cores' dofs
+  RCP<const Map> ownedDofMap_, overlapDofMap_;
+  std::vector<LO> columnOf_;            // per assembly dof: local column of the matrix, or -1
+  std::vector<std::vector<int>> coupled_;  // per effect: entities with a core face node
+  double time_ = 0;
   std::vector<std::unique_ptr<Effect>> effects_;
   BrickEffect* bricks_ = nullptr;
   std::vector<FoundationEffect*> foundations_;

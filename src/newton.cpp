@@ -139,6 +139,21 @@ RCP<Tpetra::MultiVector<>> rigidBodyModes(const Assembly& assembly) {
     modes->replaceLocalValue(d + 0, 4, z), modes->replaceLocalValue(d + 2, 4, -x);
     modes->replaceLocalValue(d + 0, 5, -y), modes->replaceLocalValue(d + 1, 5, x);
   }
+  // Rigid cores move with the body: translations move T; a rotation omega
+  // moves T by omega x (A - c) and turns the core by omega . d.
+  const auto& cores = assembly.rigidCores();
+  for (size_t k = 0; k < cores.size(); ++k) {
+    if (assembly.ownedCoreDof(k, 0) < 0) continue;
+    const LO d = assembly.ownedCoreDof(k, 0);
+    const auto& A = cores[k].axisPoint;
+    const auto& ax = cores[k].axisDirection;
+    const double x = A[0] - c[0], y = A[1] - c[1], z = A[2] - c[2];
+    for (int i = 0; i < 3; ++i) modes->replaceLocalValue(d + i, i, 1.0);
+    modes->replaceLocalValue(d + 1, 3, -z), modes->replaceLocalValue(d + 2, 3, y);
+    modes->replaceLocalValue(d + 0, 4, z), modes->replaceLocalValue(d + 2, 4, -x);
+    modes->replaceLocalValue(d + 0, 5, -y), modes->replaceLocalValue(d + 1, 5, x);
+    for (int m = 0; m < 3; ++m) modes->replaceLocalValue(d + 3, 3 + m, ax[m]);
+  }
   return modes;
 }
 

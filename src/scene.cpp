@@ -83,10 +83,24 @@ ParameterList validParameters() {
   auto& sup = p.sublist("Supports", false, "Boundary supports, one sublist per support, any name");
   auto& s = sup.sublist(kAnyName, false, "A support");
   s.set("Face", std::string(""), "Name of the mesh face it acts on");
-  s.set("Type", std::string("Fixed"), "Fixed | Roller | Foundation | Displacement");
+  s.set("Type", std::string("Fixed"), "Fixed | Roller | Foundation | Displacement | Rigid Core");
   s.set("Components", std::string("xyz"), "Roller, Foundation, Displacement: components acted on, e.g. \"y\" or \"xz\"");
   s.set("Stiffness", 1.0, "Foundation: k > 0, traction -k (x - X) per reference area");
   s.set("Velocity", vec3(0, 0, 0), "Displacement: u = Velocity * t on the listed components");
+  s.set("Axis Point", vec3(0, 0, 0), "Rigid Core: a point of the core's axis");
+  s.set("Axis Direction", vec3(0, 0, 1), "Rigid Core: the axis it turns about (right-hand rule, non-zero)");
+  s.set("Free Translation", std::string(""),
+        "Rigid Core: the components it may translate along, e.g. \"y\"; \"\" holds all");
+  s.set("Force", vec3(0, 0, 0),
+        "Rigid Core: external force on the core (a spring's preload), only along free components");
+  s.set("Force Ramp Time", 0.0,
+        "Rigid Core: Force and Torque grow linearly from 0 and are reached at this time (> 0), then "
+        "held; 0 = the first step's end");
+  s.set("Rotation", std::string("Fixed"), "Rigid Core: Fixed | Free | Prescribed (about the axis)");
+  s.set("Torque", 0.0,
+        "Rigid Core, Rotation = Free: external torque on the core about its axis (right-hand rule; "
+        "a brake acts against the rotation), ramped like Force");
+  s.set("Angular Velocity", 0.0, "Rigid Core, Rotation = Prescribed: rad per unit time, right-hand rule");
 
   auto& caps = p.sublist("Capstans", false, "Rigid cylinders (formulation.md §2), one sublist each, any name");
   auto& c = caps.sublist(kAnyName, false, "A capstan");
@@ -641,6 +655,94 @@ static void rejectOtherMeshTypeParameters(const ParameterList& user, const Valid
                                  (type == "Box" ? "Annulus" : "Box") + ")");
 }
 
+// Rigid Core parameters on another support type would be silently ignored
+// (most likely a misspelled Type): an error, checked before defaults fill in.
+static void rejectRigidCoreParametersElsewhere(const ParameterList& user, const Validator& v) {
+  if (!user.isSublist("Supports")) return;
+  const auto& sups = user.sublist("Supports");
+  for (auto it = sups.begin(); it != sups.end(); ++it) {
+    const std::string name = sups.name(it);
+    if (!sups.isSublist(name)) continue;  // check() reports it
+    const auto& s = sups.sublist(name);
+    const std::string type = s.isType<std::string>("Type") ? s.get<std::string>("Type") : "Fixed";
+    if (type == "Rigid Core") continue;
+    for (const char* n : {"Axis Point", "Axis Direction", "Free Translation", "Force", "Force Ramp Time",
+                          "Rotation", "Torque", "Angular Velocity"})
+      if (s.isParameter(n))
+        v.fail("Supports/" + name + "/" + n, "is a parameter of Type = Rigid Core only, not of " + type);
+  }
+}
+
+// Rigid Core: the rigid body's axis, its free components and its loads.
+static void readRigidCore(const ParameterList& s, const std::string& path, const Validator& v, SupportSpec& spec) {
+  spec.axisPoint = three<double>(s, "Axis Point", v, path);
+  for (double x : spec.axisPoint)
+    if (!std::isfinite(x)) v.fail(path + "/Axis Point", "must be finite numbers");
+  auto& d = spec.axisDirection;
+  d = three<double>(s, "Axis Direction", v, path);
+  const double m = std::max({std::fabs(d[0]), std::fabs(d[1]), std::fabs(d[2])});
+  if (!(m > 0) || !std::isfinite(m)) v.fail(path + "/Axis Direction", "must be a finite non-zero vector");
+  for (double& x : d) x = std::ldexp(x, -std::ilogb(m));
+  const double n = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  for (double& x : d) x /= n;
+  const std::string free = s.get<std::string>("Free Translation");
+  if (free.find_first_not_of(" ,") != std::string::npos)
+    spec.freeTranslation = components(free, v, path + "/Free Translation");
+  spec.force = three<double>(s, "Force", v, path);
+  for (int i = 0; i < 3; ++i) {
+    if (!std::isfinite(spec.force[i])) v.fail(path + "/Force", "must be finite numbers");
+    if (spec.force[i] != 0 && !spec.freeTranslation[i])
+      v.fail(path + "/Force", std::string("component ") + char('x' + i) + " is not zero, but the core is held along " +
+                                  char('x' + i) + " (not in Free Translation '" + free + "')");
+  }
+  spec.rampTime = s.get<double>("Force Ramp Time");
+  if (!(spec.rampTime >= 0) || !std::isfinite(spec.rampTime)) v.fail(path + "/Force Ramp Time", "must be >= 0");
+  spec.rotation = s.get<std::string>("Rotation");
+  if (spec.rotation != "Fixed" && spec.rotation != "Free" && spec.rotation != "Prescribed")
+    v.fail(path + "/Rotation", "'" + spec.rotation + "' is not a rotation (Fixed, Free, Prescribed)");
+  spec.torque = s.get<double>("Torque");
+  if (!std::isfinite(spec.torque)) v.fail(path + "/Torque", "must be a finite number");
+  if (spec.torque != 0 && spec.rotation != "Free")
+    v.fail(path + "/Torque", "an applied torque needs Rotation = Free (it is '" + spec.rotation + "')");
+  spec.angularVelocity = s.get<double>("Angular Velocity");
+  if (!std::isfinite(spec.angularVelocity)) v.fail(path + "/Angular Velocity", "must be a finite number");
+  if (spec.angularVelocity != 0 && spec.rotation != "Prescribed")
+    v.fail(path + "/Angular Velocity", "needs Rotation = Prescribed (it is '" + spec.rotation + "')");
+}
+
+// A free rigid-core component that nothing can ever hold makes every tangent
+// singular: an input error rather than a failed solve. Capstan contact pushes
+// along directions normal to the capstan's axis, friction along the surface;
+// a rotation is held only by friction.
+static void rejectSingularCores(const Scene& sc, const Validator& v) {
+  for (const auto& s : sc.supports) {
+    if (s.type != "Rigid Core") continue;
+    const std::string path = "Supports/" + s.name;
+    if (s.rotation == "Free") {
+      bool friction = false;
+      for (const auto& c : sc.capstans) friction |= c.frictionLaw != "None" && c.frictionCoefficient > 0;
+      if (!friction)
+        v.fail(path + "/Rotation", "Free, but no capstan has friction (Friction/Law and Coefficient > 0): "
+                                   "nothing can hold the core's rotation (use Fixed or Prescribed, or add friction)");
+    }
+    for (int i = 0; i < 3; ++i) {
+      if (!s.freeTranslation[i]) continue;
+      bool held = false;
+      for (const auto& c : sc.capstans) {
+        const auto& b = c.axisDirection;
+        const double nb = std::sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+        held |= std::fabs(b[i]) / nb < 1 - 1e-12;  // the capstan's normals have a component along i
+      }
+      if (!held)
+        v.fail(path + "/Free Translation",
+               std::string("the core is free along ") + char('x' + i) +
+                   ", but no capstan can push it along " + char('x' + i) +
+                   (sc.capstans.empty() ? " (the scene has no capstans)" : " (every capstan's axis is along it)") +
+                   ": nothing holds it; hold that component or add a capstan");
+    }
+  }
+}
+
 std::vector<std::string> MeshSpec::faceNames() const {
   if (type == "Annulus") return {"inner", "outer", "zmin", "zmax"};
   return {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
@@ -671,6 +773,7 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
   if (!outputOverride.empty()) user->sublist("Output").set("Directory", outputOverride);
   applyAccuracyPreset(*user, v);
   rejectOtherMeshTypeParameters(*user, v);
+  rejectRigidCoreParametersElsewhere(*user, v);
   v.check(*user, valid, "");
 
   Scene sc;
@@ -742,12 +845,13 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
     spec.face = s.get<std::string>("Face");
     spec.type = s.get<std::string>("Type");
     if (!faceNames.count(spec.face)) v.fail(path + "/Face", "'" + spec.face + "' is not a face of the mesh (" + faceText + ")");
-    if (spec.type == "Fixed") spec.components = {true, true, true};
+    if (spec.type == "Fixed" || spec.type == "Rigid Core") spec.components = {true, true, true};
     else if (spec.type == "Roller" || spec.type == "Foundation" || spec.type == "Displacement")
       spec.components = components(s.get<std::string>("Components"), v, path + "/Components");
-    else v.fail(path + "/Type", "'" + spec.type + "' is not a support type (Fixed, Roller, Foundation, Displacement)");
+    else v.fail(path + "/Type", "'" + spec.type + "' is not a support type (Fixed, Roller, Foundation, Displacement, Rigid Core)");
     if (spec.type == "Foundation") spec.stiffness = positive(s, "Stiffness", v, path);
     spec.velocity = three<double>(s, "Velocity", v, path);
+    if (spec.type == "Rigid Core") readRigidCore(s, path, v, spec);
     sc.supports.push_back(spec);
   }
 
@@ -818,6 +922,9 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
   sc.steps = time.get<int>("Steps");
   if (sc.steps < 1) v.fail("Time/Steps", "must be >= 1, got " + std::to_string(sc.steps));
   sc.stepSize = positive(time, "Step Size", v, "Time");
+  rejectSingularCores(sc, v);
+  for (auto& s : sc.supports)
+    if (s.type == "Rigid Core" && s.rampTime == 0) s.rampTime = sc.stepSize;
 
   sc.solver = P.sublist("Solver");
   const auto& sol = sc.solver;

@@ -23,10 +23,20 @@ struct MeshSpec {
 };
 
 struct SupportSpec {
-  std::string name, face, type;        // type: Fixed | Roller | Foundation | Displacement
+  std::string name, face, type;        // type: Fixed | Roller | Foundation | Displacement | Rigid Core
   std::array<bool, 3> components{};    // which of x, y, z the support acts on
   double stiffness = 0;                // Foundation
   std::array<double, 3> velocity{};    // Displacement: u = velocity * t
+  // Rigid Core (interface.md "Pinch roller"): the face follows a rigid body
+  // turning about axisDirection (unit) through axisPoint and translating along
+  // the free components.
+  std::array<double, 3> axisPoint{}, axisDirection{0, 0, 1};
+  std::array<bool, 3> freeTranslation{};
+  std::array<double, 3> force{};       // external force on the core, ramped to rampTime
+  double rampTime = 0;                 // > 0 (the first step's end when not given)
+  std::string rotation = "Fixed";      // Fixed | Free | Prescribed
+  double torque = 0;                   // Free: external torque on the core, ramped like force
+  double angularVelocity = 0;          // Prescribed
 };
 
 struct CapstanSpec {

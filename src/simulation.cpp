@@ -47,12 +47,24 @@ struct CapstanRecord {
   double frictionIntegral = 0, normalIntegral = 0, maxFrictionRatio = 0;
 };
 
+// A support's figures at a converged step (global). Rigid cores add their
+// motion and torque.
+struct SupportRecord {
+  std::string name;
+  std::array<double, 3> force{};  // support (core) on body
+  bool core = false;
+  double torque = 0, rotation = 0, angularVelocity = 0;
+  bool hasSpeedRatio = false;
+  double speedRatio = 0;  // roller surface speed / capstan surface speed
+  std::array<double, 3> translation{};
+};
+
 struct StepRecord {
   int step = 0;
   double time = 0;
   int newton = 0, linear = 0, cutbacks = 0, augmentations = 0;
   double residual = 0, wall = 0, volumeChange = 0;
-  std::vector<std::pair<std::string, std::array<double, 3>>> supports;
+  std::vector<SupportRecord> supports;
   std::vector<CapstanRecord> capstans;
   double maxPenetration() const {
     double m = 0;
@@ -108,7 +120,10 @@ void putRecord(checkpoint::Writer& w, const StepRecord& r) {
   w.put(r.step), w.put(r.time), w.put(r.newton), w.put(r.linear), w.put(r.cutbacks);
   w.put(r.augmentations), w.put(r.residual), w.put(r.wall), w.put(r.volumeChange);
   w.put<int>(int(r.supports.size()));
-  for (const auto& s : r.supports) w.put(s.first), w.put(s.second);
+  for (const auto& s : r.supports) {
+    w.put(s.name), w.put(s.force), w.put(s.core), w.put(s.torque), w.put(s.rotation), w.put(s.angularVelocity);
+    w.put(s.translation), w.put(s.hasSpeedRatio), w.put(s.speedRatio);
+  }
   w.put<int>(int(r.capstans.size()));
   for (const auto& c : r.capstans) {
     w.put(c.name), w.put(c.force), w.put(c.torque), w.put(c.maxPenetration), w.put(c.peakPressure);
@@ -125,7 +140,12 @@ StepRecord getRecord(checkpoint::Reader& in) {
   const int ns = in.get<int>();
   for (int i = 0; i < ns; ++i) {
     auto name = in.getString();
-    r.supports.push_back({name, in.get<std::array<double, 3>>()});
+    SupportRecord s;
+    s.name = name, s.force = in.get<std::array<double, 3>>(), s.core = in.get<bool>();
+    s.torque = in.get<double>(), s.rotation = in.get<double>(), s.angularVelocity = in.get<double>();
+    s.translation = in.get<std::array<double, 3>>();
+    s.hasSpeedRatio = in.get<bool>(), s.speedRatio = in.get<double>();
+    r.supports.push_back(s);
   }
   const int nc = in.get<int>();
   for (int i = 0; i < nc; ++i) {
@@ -254,8 +274,7 @@ void Run::predict(double t0, double t1, double bareResidual, StepRecord& rec) {
     auto r = rhs.getDataNonConst();
     auto fd = f.getData();
     auto kz = Kz.getData();
-    const auto& supportOf = assembly_->constraints().supportOf;
-    for (LO d = 0; d < LO(r.size()); ++d) r[d] = supportOf[d] >= 0 ? 0.0 : -(fd[d] + kz[d]);
+    for (LO d = 0; d < LO(r.size()); ++d) r[d] = assembly_->ownedConstrained(d) ? 0.0 : -(fd[d] + kz[d]);
   }
   const int its = newton_->linearSolve(W, rhs, du);
   for (const auto& e : assembly_->effects()) e->setPredicting(false);
@@ -285,7 +304,7 @@ void Run::checkTangent() {
   {
     auto d = v.getDataNonConst();
     for (LO i = 0; i < LO(d.size()); ++i)
-      if (assembly_->constraints().supportOf[i] >= 0) d[i] = 0;
+      if (assembly_->ownedConstrained(i)) d[i] = 0;
   }
   auto W = assembly_->createMatrix();
   assembly_->evaluate(*u_, nullptr, W.get());
@@ -507,7 +526,43 @@ void Run::recordStep(StepRecord& rec) {
     Teuchos::reduceAll(*comm_, Teuchos::REDUCE_SUM, 3, local.data(), g);
     byName[f->name().substr(std::string("foundation:").size())] = {g[0], g[1], g[2]};
   }
-  for (const auto& s : scene_.supports) rec.supports.push_back({s.name, byName[s.name]});
+  for (const auto& s : scene_.supports) {
+    SupportRecord sr;
+    sr.name = s.name, sr.force = byName[s.name];
+    rec.supports.push_back(sr);
+  }
+  // Rigid cores: the reactions at the face nodes are the force of the core on
+  // the body; angular velocity over the step (formulation: increment / dt).
+  for (const auto& core : assembly_->rigidCores()) {
+    auto& sr = *std::find_if(rec.supports.begin(), rec.supports.end(),
+                             [&](const SupportRecord& x) { return x.name == core.name; });
+    sr.core = true;
+    sr.force = core.forceOnBody;
+    sr.torque = core.torqueOnBody;
+    sr.translation = core.translation;
+    sr.rotation = core.rotation;
+    double before = 0, tBefore = 0;
+    if (!steps_.empty()) {
+      tBefore = steps_.back().time;
+      for (const auto& p : steps_.back().supports)
+        if (p.name == core.name) before = p.rotation;
+    }
+    sr.angularVelocity = (core.rotation - before) / (rec.time - tBefore);
+    // Against the first spinning capstan: surface speeds omega R, the roller's
+    // at its outer (undeformed) radius; positive when the nip's surfaces move
+    // together (external contact: the roller turns against the capstan).
+    if (scene_.mesh.type != "Annulus") continue;
+    for (const auto& c : scene_.capstans) {
+      if (c.angularVelocity == 0) continue;
+      const auto& b = c.axisDirection;
+      const double nb = std::sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+      const auto& d = core.axisDirection;
+      const double along = (d[0] * b[0] + d[1] * b[1] + d[2] * b[2]) / nb;
+      sr.hasSpeedRatio = true;
+      sr.speedRatio = -sr.angularVelocity * scene_.mesh.outerRadius * along / (c.angularVelocity * c.radius);
+      break;
+    }
+  }
   for (size_t i = 0; i < assembly_->contacts().size(); ++i)
     rec.capstans.push_back(capstanFigures(*assembly_->contacts()[i], assembly_->frictions()[i]));
 }
@@ -638,7 +693,7 @@ void Run::writeHistory() {
         << r.cutbacks << "," << r.augmentations << "," << json::number(r.residual) << ","
         << json::number(r.volumeChange) << "," << json::number(r.wall);
     for (const auto& s : r.supports)
-      for (double x : s.second) out << "," << json::number(x);
+      for (double x : s.force) out << "," << json::number(x);
     for (const auto& c : r.capstans) {
       for (double x : c.force) out << "," << json::number(x);
       out << "," << json::number(c.maxPenetration) << "," << c.points;
@@ -660,7 +715,15 @@ void Run::writeSummary(bool converged, const std::string& failure) {
   for (size_t i = 0; i < steps_.size(); ++i) {
     const auto& r = steps_[i];
     Object sup;
-    for (const auto& sp : r.supports) sup.add(sp.first, Object().add("force", vec(sp.second)).str());
+    for (const auto& sp : r.supports) {
+      Object o;
+      o.add("force", vec(sp.force));
+      if (sp.core)
+        o.add("torque", json::number(sp.torque)).add("translation", vec(sp.translation))
+            .add("rotation", json::number(sp.rotation)).add("angular_velocity", json::number(sp.angularVelocity));
+      if (sp.hasSpeedRatio) o.add("speed_ratio", json::number(sp.speedRatio));
+      sup.add(sp.name, o.str());
+    }
     Object caps;
     for (const auto& c : r.capstans)
       caps.add(c.name, Object().add("force", vec(c.force))
@@ -809,7 +872,8 @@ std::string Run::checkpointBytes(int step, double time) const {
   std::vector<long long> gids(mesh_.nodeGids.begin(), mesh_.nodeGids.begin() + mesh_.numOwnedNodes);
   auto ud = u_->getData();
   w.put(gids);
-  w.put(std::vector<double>(ud.begin(), ud.end()));
+  w.put(std::vector<double>(ud.begin(), ud.begin() + 3 * mesh_.numOwnedNodes));
+  w.put(std::vector<double>(ud.begin() + 3 * mesh_.numOwnedNodes, ud.end()));  // rigid cores (rank 0)
   // Every effect's multipliers and history, by its entities' node ids.
   const auto& effects = assembly_->effects();
   w.put<int>(int(effects.size()));
@@ -947,6 +1011,7 @@ void Run::restore(Restart& r) {
     // Displacement: every owned node's value, found by node id.
     const auto gids = in.getVector<long long>();
     const auto u = in.getVector<double>();
+    const auto cores = in.getVector<double>();
     if (gids.size() != mesh_.numOwnedNodes || u.size() != 3 * gids.size())
       throw std::runtime_error("holds " + std::to_string(gids.size()) + " nodes, this rank owns " +
                                std::to_string(mesh_.numOwnedNodes) + " (another mesh or partition)");
@@ -958,6 +1023,10 @@ void Run::restore(Restart& r) {
       if (it == owned.end()) throw std::runtime_error("node " + std::to_string(gids[i]) + " is not owned here");
       for (int c = 0; c < 3; ++c) ud[3 * it->second + c] = u[3 * i + c];
     }
+    if (cores.size() != ud.size() - 3 * mesh_.numOwnedNodes)
+      throw std::runtime_error("holds " + std::to_string(cores.size()) + " rigid-core values, the scene has " +
+                               std::to_string(ud.size() - 3 * mesh_.numOwnedNodes) + " here");
+    for (size_t j = 0; j < cores.size(); ++j) ud[3 * mesh_.numOwnedNodes + j] = cores[j];
     // Effects: the same ones, each value put back on its entity by node ids.
     const auto& effects = assembly_->effects();
     std::string have, want;
@@ -1053,7 +1122,7 @@ int Run::execute() {
   } catch (const InputError& e) {  // the Solver/NOX or Solver/Stratimikos sublist
     throw InputError(scene_.file + ": " + e.what());
   }
-  u_ = rcp(new Vector(mesh_.ownedDofMap));
+  u_ = rcp(new Vector(assembly_->dofMap()));
   double size2 = 0;
   for (int d = 0; d < 3; ++d) size2 = std::max(size2, std::pow(m.max[d] - m.min[d], 2));
   forceScale_ = scene_.c * size2;
@@ -1170,6 +1239,7 @@ int Run::execute() {
     }
     if (!ok) break;
     {
+      assembly_->applyConstraints(*u_, tDone);  // rigid cores' face nodes where the cores are
       Vector f(u_->getMap());
       assembly_->evaluate(*u_, &f, nullptr);  // reactions at the converged state
     }
@@ -1184,6 +1254,12 @@ int Run::execute() {
       std::printf("step %d/%d  t=%.4g  newton=%d  linear=%d  |R|=%.3e  dV=%.1e  max_penetration=%.3e  %.2fs\n",
                   step, N, rec.time, rec.newton, rec.linear, rec.residual, rec.volumeChange,
                   rec.maxPenetration(), since(t0_) + timingOffset_[0]);
+      for (const auto& sr : rec.supports) {
+        if (!sr.core) continue;
+        std::printf("    %s: rotation=%.5g  omega=%.5g", sr.name.c_str(), sr.rotation, sr.angularVelocity);
+        if (sr.hasSpeedRatio) std::printf("  speed_ratio=%.6f", sr.speedRatio);
+        std::printf("  force=(%.5g, %.5g, %.5g)  torque=%.4g\n", sr.force[0], sr.force[1], sr.force[2], sr.torque);
+      }
       std::fflush(stdout);
     }
   }
