@@ -23,7 +23,31 @@ namespace capstan::kernels {
 // The cylinder at the current time: axis point a, unit direction b, radius R.
 struct Cylinder {
   double a[3], b[3], R;
+  // The contact law's corner: t_n = max(0, tn) (0), or a smooth max with this
+  // pressure scale (see contactPressure).
+  double smoothing = 0;
 };
+
+// Contact pressure from the trial normal traction tn: max(0, tn), or with
+// smoothing eta > 0 the smooth max (tn + sqrt(tn^2 + eta^2)) / 2, which differs
+// from it by at most eta / 2 and removes the corner where points enter and
+// leave contact. Newton stalls at that corner when contact points keep
+// crossing it (a rolling body brings new points into the nip every step).
+// Below tn = -1e4 eta the pressure (under 2.5e-5 eta) is cut to 0, so faces
+// away from the capstan stay inactive. slope = d t_n / d tn.
+KOKKOS_INLINE_FUNCTION double contactPressure(double tn, double eta, double& slope) {
+  if (eta > 0) {
+    if (tn < -1e4 * eta) {
+      slope = 0;
+      return 0;
+    }
+    const double r = sqrt(tn * tn + eta * eta);
+    slope = 0.5 * (1 + tn / r);
+    return 0.5 * (tn + r);
+  }
+  slope = tn > 0 ? 1.0 : 0.0;
+  return tn > 0 ? tn : 0.0;
+}
 
 // Face quadrature rules: 2x2 Gauss (default), 3x3 Gauss, or nodal (2x2 Lobatto,
 // one point at each node: contact is then checked where the nodes are).
@@ -99,7 +123,7 @@ KOKKOS_INLINE_FUNCTION bool contactFaceResidualTangent(const double X[4][3], con
                                                        bool geometric = true) {
   const int nq = facePointCount(rule);
   bool touching = false;
-  double N[kMaxFacePoints][4];
+  double N[kMaxFacePoints][4], slope[kMaxFacePoints];
   for (int q = 0; q < nq; ++q) {
     double xi, eta, w, dN[4][2];
     facePoint(rule, q, xi, eta, w);
@@ -113,8 +137,8 @@ KOKKOS_INLINE_FUNCTION bool contactFaceResidualTangent(const double X[4][3], con
     double d;
     p.gap = cylinderGap(cyl, p.x, p.e, d);
     const double tn = lambda[q] + (p.gap - kappa * lambda[q]) / eps;
-    p.pressure = tn > 0 ? tn : 0.0;
-    touching = touching || tn > 0;
+    p.pressure = contactPressure(tn, cyl.smoothing, slope[q]);
+    touching = touching || p.pressure > 0;
   }
   if (!touching) return false;
 
@@ -129,12 +153,12 @@ KOKKOS_INLINE_FUNCTION bool contactFaceResidualTangent(const double X[4][3], con
     if (!K) continue;
     const double d = cyl.R - p.gap;
     const double geo = geometric && d > 1e-300 ? p.pressure / d : 0.0;
-    // C = -dt/dx = (1/eps) e e^T - (t_n/d)(P - e e^T)
+    // C = -dt/dx = (slope/eps) e e^T - (t_n/d)(P - e e^T)
     double C[3][3];
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) {
         const double P = (i == j ? 1.0 : 0.0) - cyl.b[i] * cyl.b[j];
-        C[i][j] = p.e[i] * p.e[j] / eps - geo * (P - p.e[i] * p.e[j]);
+        C[i][j] = slope[q] * p.e[i] * p.e[j] / eps - geo * (P - p.e[i] * p.e[j]);
       }
     for (int a = 0; a < 4; ++a)
       for (int b = 0; b < 4; ++b) {

@@ -29,6 +29,12 @@ struct FrictionParameters {
   double tangentPenalty = 1e-3;  // Coulomb: eps_t, slip per unit traction while sticking
   double ds[3] = {0, 0, 0};    // translation of the capstan in the increment
   double spin = 0;             // omega dt R: surface travel of the turning capstan
+  // Coulomb: width delta of a smoothed stick/slip corner (0: the exact return
+  // mapping). t = t* / m(s), s = |t*| / (mu t_n), m = (1 + s + sqrt((s-1)^2 +
+  // delta^2)) / 2 >= max(1, s): |t| <= mu t_n still, stick traction softened by
+  // about delta^2 / 4, |t| = mu t_n / (1 + delta/2) at the corner. Newton stalls
+  // at the exact corner when points keep switching (rolling contact).
+  double smoothing = 0;
   // Step predictor only: every point sticks (Coulomb: the trial traction, no
   // return mapping; regularised laws: their zero-slip slope, t = mu t_n du_t / v),
   // so the linear response moves the body with the capstan where friction holds.
@@ -90,7 +96,8 @@ KOKKOS_INLINE_FUNCTION bool frictionFaceResidualTangent(
     for (int a = 0; a < 4; ++a)
       for (int i = 0; i < 3; ++i) xq[i] += N[a] * x[a][i];
     const double g = cylinderGap(cyl, xq, e, d);
-    touching = lambda[q] + (g - kappa * lambda[q]) / eps > 0;
+    double slope;
+    touching = contactPressure(lambda[q] + (g - kappa * lambda[q]) / eps, cyl.smoothing, slope) > 0;
   }
   for (int q = 0; q < nq; ++q) pts[q] = FrictionPoint();
   if (!touching) return false;
@@ -112,7 +119,8 @@ KOKKOS_INLINE_FUNCTION bool frictionFaceResidualTangent(
         xnq[i] += N[a] * xn[a][i];
       }
     const double g = cylinderGap(cyl, xq, e, d);
-    const double tn = lambda[q] + (g - kappa * lambda[q]) / eps;
+    double slope;  // dtn/dx = -(slope/eps) e^T
+    const double tn = contactPressure(lambda[q] + (g - kappa * lambda[q]) / eps, cyl.smoothing, slope);
     if (!(tn > 0)) continue;
     p.normal = tn;
     for (int i = 0; i < 3; ++i) p.e[i] = e[i];
@@ -146,7 +154,6 @@ KOKKOS_INLINE_FUNCTION bool frictionFaceResidualTangent(
       }
     const double slip = sqrt(dut[0] * dut[0] + dut[1] * dut[1] + dut[2] * dut[2]);
     p.slip = slip;
-    // dtn/dx = -(1/eps) e^T
     double t[3], T[3][3];  // traction and dt/dx
     if (fp.law == FrictionLaw::Coulomb) {
       const double* h = history + 3 * q;
@@ -160,7 +167,23 @@ KOKKOS_INLINE_FUNCTION bool frictionFaceResidualTangent(
           Tr[i][j] = -e[i] * hE[j] - eh * E[i][j] + Dt[i][j] / fp.tangentPenalty;
       }
       const double mag = sqrt(tr[0] * tr[0] + tr[1] * tr[1] + tr[2] * tr[2]);
-      if (mag <= fp.mu * tn || fp.stickPredictor) {  // stick
+      if (fp.smoothing > 0 && fp.mu > 0 && !fp.stickPredictor) {  // smoothed corner
+        const double s = mag / (fp.mu * tn);
+        const double r = sqrt((s - 1) * (s - 1) + fp.smoothing * fp.smoothing);
+        const double m = 0.5 * (1 + s + r), dm = 0.5 * (1 + (s - 1) / r);
+        p.state = s <= 1 ? 1 : 2;
+        double dS[3];  // ds/dx = (n^T Tr) / (mu t_n) - s / t_n dt_n/dx, dt_n/dx = -(slope/eps) e^T
+        for (int j = 0; j < 3; ++j) {
+          double nTr = 0;
+          if (mag > 1e-300)
+            for (int k = 0; k < 3; ++k) nTr += tr[k] / mag * Tr[k][j];
+          dS[j] = nTr / (fp.mu * tn) + s / tn * slope * e[j] / eps;
+        }
+        for (int i = 0; i < 3; ++i) {
+          t[i] = tr[i] / m;
+          for (int j = 0; j < 3; ++j) T[i][j] = Tr[i][j] / m - tr[i] / (m * m) * dm * dS[j];
+        }
+      } else if (mag <= fp.mu * tn || fp.stickPredictor) {  // stick
         p.state = 1;
         for (int i = 0; i < 3; ++i) {
           t[i] = tr[i];
@@ -175,7 +198,7 @@ KOKKOS_INLINE_FUNCTION bool frictionFaceResidualTangent(
           for (int j = 0; j < 3; ++j) {
             double s = 0;
             for (int k = 0; k < 3; ++k) s += ((i == k ? 1.0 : 0.0) - n[i] * n[k]) * Tr[k][j];
-            T[i][j] = fp.mu * (n[i] * (-e[j] / eps) + tn * s / mag);
+            T[i][j] = fp.mu * (n[i] * (-slope * e[j] / eps) + tn * s / mag);
           }
         }
       }
@@ -189,7 +212,7 @@ KOKKOS_INLINE_FUNCTION bool frictionFaceResidualTangent(
       for (int i = 0; i < 3; ++i) {
         t[i] = fp.mu * tn * psi * dut[i];
         for (int j = 0; j < 3; ++j)
-          T[i][j] = fp.mu * (psi * dut[i] * (-e[j] / eps) + tn * chi * dut[i] * dutDt[j] +
+          T[i][j] = fp.mu * (psi * dut[i] * (-slope * e[j] / eps) + tn * chi * dut[i] * dutDt[j] +
                              tn * psi * Dt[i][j]);
       }
     }

@@ -91,6 +91,7 @@ Assembly::Assembly(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
     set.tolerance = c.penetrationTolerance;
     set.maxAugmentations = c.maxAugmentations;
     set.rule = c.quadrature;
+    set.smoothing = c.smoothing;
     // Candidate faces, each once even if two named faces share one. Every
     // capstan's faces also get an index in the union of all candidate faces
     // (the contact-face grid of fields.h5).
@@ -122,6 +123,7 @@ Assembly::Assembly(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
     fs.mu = c.frictionCoefficient;
     fs.regularization = c.regularization;
     fs.tangentPenalty = c.tangentialPenalty;
+    fs.smoothing = c.frictionSmoothing;
     fs.angularVelocity = c.angularVelocity;
     auto friction = std::make_unique<FrictionEffect>("friction:" + c.name, mesh, quads, contact, fs);
     frictions_.back() = friction.get();

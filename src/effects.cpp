@@ -283,6 +283,7 @@ kernels::Cylinder ContactEffect::cylinder() const {
     cyl.b[i] = beta_[i];
   }
   cyl.R = settings_.radius;
+  cyl.smoothing = settings_.smoothing;
   return cyl;
 }
 
@@ -452,6 +453,7 @@ FrictionEffect::FrictionEffect(const std::string& name, const Mesh& mesh,
       });
   parameters_.law = settings.law;
   parameters_.mu = settings.mu;
+  parameters_.smoothing = settings.smoothing;
   parameters_.tangentPenalty =
       settings.tangentPenalty > 0 ? settings.tangentPenalty : contact.solvePenalty();
 }

@@ -168,6 +168,7 @@ class ContactEffect : public Effect {
     double tolerance = 0;        // on eps |t_n - lambda| (length); 0 = 1e-4 x smallest edge
     int maxAugmentations = 50;
     int rule = 0;                // kernels::FaceRule
+    double smoothing = 0;        // pressure scale of the contact law's smoothed corner (0: max(0, .))
   };
   ContactEffect(const std::string& name, const Mesh& mesh, const std::vector<int>& quads,
                 const Settings& settings);
@@ -245,6 +246,7 @@ class FrictionEffect : public Effect {
     double mu = 0;
     double regularization = 1e-3;  // eps3 / eps4: slip speed scale
     double tangentPenalty = 0;     // Coulomb eps_t; 0: the contact's solve penalty
+    double smoothing = 0;          // Coulomb: width of the smoothed stick/slip corner
     double angularVelocity = 0;
   };
   FrictionEffect(const std::string& name, const Mesh& mesh, const std::vector<int>& quads,

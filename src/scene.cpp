@@ -127,6 +127,10 @@ ParameterList validParameters() {
               "Contact points per face: Auto | Gauss 2x2 | Gauss 3x3 | Nodal (at the face's nodes). "
               "Auto: Gauss 2x2 for Penalty, Nodal for Augmented Lagrangian (exact contact at every "
               "Gauss point of flat faces on a curved capstan over-constrains the body)");
+  contact.set("Smoothing", 0.0,
+              "Pressure scale eta >= 0 of a smoothed contact law: t_n = (tn + sqrt(tn^2 + eta^2)) / 2 "
+              "instead of max(0, tn), at most eta/2 different. Removes the corner where points enter "
+              "and leave contact, at which Newton stalls in rolling contact; 0 = the exact max");
   auto& fr = c.sublist("Friction", false, "Friction between body and capstan (formulation.md §3)");
   fr.set("Law", std::string("None"), "None | Tanh | Arctan | Coulomb");
   fr.set("Coefficient", 0.0, "mu >= 0");
@@ -134,6 +138,12 @@ ParameterList validParameters() {
   fr.set("Tangential Penalty", 0.0,
          "Coulomb: eps_t > 0, tangential slip per unit friction traction while sticking; "
          "0 = the contact's solve penalty");
+
+  fr.set("Smoothing", 0.0,
+         "Coulomb: width delta >= 0 of a smoothed stick/slip corner, t = t* / m(|t*| / (mu t_n)) with "
+         "m(s) = (1 + s + sqrt((s-1)^2 + delta^2)) / 2: |t| <= mu t_n still, sticking traction "
+         "softened by about delta^2/4. Removes the corner at which Newton stalls when points keep "
+         "switching between stick and slip (rolling); 0 = the exact return mapping");
 
   auto& time = p.sublist("Time", false, "Quasi-static load steps t_n = n dt");
   time.set("Steps", 1, "Number of steps (>= 1)");
@@ -899,6 +909,8 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
       v.fail(path + "/Contact/Quadrature",
              "the Augmented Lagrangian needs Nodal (or Auto): zero gap at every Gauss point of flat "
              "faces against a curved capstan is impossible, and the multipliers would never settle");
+    cs.smoothing = ct.get<double>("Smoothing");
+    if (!(cs.smoothing >= 0) || !std::isfinite(cs.smoothing)) v.fail(path + "/Contact/Smoothing", "must be >= 0");
     cs.maxAugmentations = ct.get<int>("Max Augmentations");
     if (cs.maxAugmentations < 1) v.fail(path + "/Contact/Max Augmentations", "must be >= 1");
     const auto& fr = c.sublist("Friction");
@@ -912,6 +924,9 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
     cs.regularization = fr.get<double>("Regularization");
     if (!(cs.regularization > 0) || !std::isfinite(cs.regularization))
       v.fail(path + "/Friction/Regularization", "must be > 0");
+    cs.frictionSmoothing = fr.get<double>("Smoothing");
+    if (!(cs.frictionSmoothing >= 0) || !std::isfinite(cs.frictionSmoothing))
+      v.fail(path + "/Friction/Smoothing", "must be >= 0");
     cs.tangentialPenalty = fr.get<double>("Tangential Penalty");
     if (!(cs.tangentialPenalty >= 0) || !std::isfinite(cs.tangentialPenalty))
       v.fail(path + "/Friction/Tangential Penalty", "must be >= 0");

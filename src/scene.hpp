@@ -49,8 +49,9 @@ struct CapstanSpec {
   double penalty = 0, penetrationTolerance = 0, minimumSolvePenalty = 0;
   int maxAugmentations = 0;
   int quadrature = 0;  // kernels::FaceRule: 0 Gauss 2x2, 1 Gauss 3x3, 2 Nodal
+  double smoothing = 0;  // Contact/Smoothing: pressure scale of the smoothed contact corner
   std::string frictionLaw;  // None | Tanh | Arctan | Coulomb
-  double frictionCoefficient = 0, regularization = 0, tangentialPenalty = 0;
+  double frictionCoefficient = 0, regularization = 0, tangentialPenalty = 0, frictionSmoothing = 0;
 };
 
 struct Scene {
