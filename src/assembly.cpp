@@ -399,6 +399,24 @@ std::vector<std::array<double, 5>> Assembly::coreSums(const Teuchos::ArrayRCP<co
   return out;
 }
 
+void Assembly::rollWithCores(Vector& u, const std::vector<double>& dTheta) {
+  uOverlap_->doImport(u, *importer_, Tpetra::INSERT);
+  readCores(uOverlap_->getData());
+  auto data = u.getDataNonConst();
+  for (size_t c = 0; c < cores_.size(); ++c) {
+    const auto& core = cores_[c];
+    if (!core.free[3] || dTheta[c] == 0) continue;
+    for (size_t n = 0; n < mesh_.numOwnedNodes; ++n) {
+      double r[3], turned[3];
+      for (int i = 0; i < 3; ++i)
+        r[i] = mesh_.X[3 * n + i] + data[3 * n + i] - core.axisPoint[i] - core.translation[i];
+      kernels::rotateAboutAxis(core.axisDirection.data(), dTheta[c], r, turned);
+      for (int i = 0; i < 3; ++i) data[3 * n + i] += turned[i] - r[i];
+    }
+    if (coresOwned_) data[3 * mesh_.numOwnedNodes + 6 * c + 3] += dTheta[c];
+  }
+}
+
 void Assembly::applyConstraints(Vector& u, double t) {
   const auto& supportOf = constraints_.supportOf;
   {

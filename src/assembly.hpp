@@ -95,6 +95,9 @@ class Assembly {
     for (auto& e : effects_) e->setInterval(tStart, tEnd);
   }
 
+  // Turns the whole body, with each rigid core whose rotation is free, rigidly
+  // about the core's axis by dTheta[core] (a rolling body's first guess).
+  void rollWithCores(Vector& u, const std::vector<double>& dTheta);
   // Sets the constrained entries of u to their values at time t, and the rigid
   // cores' face nodes to where the cores' values in u put them.
   void applyConstraints(Vector& u, double t);

@@ -248,6 +248,7 @@ class Run {
   double absTolerance_ = 0;
   RCP<Vector> previous_;    // the state before the last converged increment (extrapolation)
   double tPrevious_ = 0;
+  std::vector<double> previousRotation_;  // the cores' rotations in that state
   double forceScale_ = 1;  // c L^2, L the body's largest extent
 };
 
@@ -354,12 +355,46 @@ bool Run::solveAt(double t0, double t, StepRecord& rec, std::string& failure) {
     Vector trial(*u_, Teuchos::Copy);
     trial.update(-(t - t0) / (t0 - tPrevious_), *previous_, 1.0 + (t - t0) / (t0 - tPrevious_));
     assembly_->applyConstraints(trial, t);
-    if (assembly_->evaluate(trial, &f, nullptr) && f.norm2() < bare) {
+    const bool valid = assembly_->evaluate(trial, &f, nullptr);
+    if (std::getenv("CAPSTAN_NEWTON_LOG") && rank0_ && !opt_.quiet)
+      std::printf("    extrapolated: valid %d |R| %.3e bare %.3e\n", int(valid), f.norm2(), bare);
+    if (valid && f.norm2() < bare) {
       u_->update(1.0, trial, 0.0);
       extrapolated = true;
     }
   }
-  if (!extrapolated && sol.get<std::string>("Predictor") == "Tangent") predict(t0, t, bare, rec);
+  // A free core driven by a spinning capstan: turn the whole body with it, at
+  // its last angular velocity (at first: rolling without slip), so that the nip
+  // starts near stick; from the bare state every point slips and the core's
+  // rotation has almost no stiffness.
+  bool rolled = false;
+  if (!extrapolated) {
+    std::vector<double> dTheta;
+    for (const auto& core : assembly_->rigidCores()) {
+      double omega = 0;
+      if (core.free[3]) {
+        if (previous_ && tPrevious_ < t0) {
+          omega = (core.rotation - previousRotation_[&core - assembly_->rigidCores().data()]) / (t0 - tPrevious_);
+        } else {
+          for (const auto& c : scene_.capstans) {
+            if (c.angularVelocity == 0 || scene_.mesh.type != "Annulus") continue;
+            const auto& b = c.axisDirection;
+            const double nb = std::sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+            const auto& d = core.axisDirection;
+            omega = -c.angularVelocity * c.radius * (d[0] * b[0] + d[1] * b[1] + d[2] * b[2]) / nb /
+                    scene_.mesh.outerRadius;
+            break;
+          }
+        }
+      }
+      dTheta.push_back(omega * (t - t0));
+    }
+    if (std::any_of(dTheta.begin(), dTheta.end(), [](double x) { return x != 0; })) {
+      assembly_->rollWithCores(*u_, dTheta);
+      rolled = true;
+    }
+  }
+  if (!extrapolated && !rolled && sol.get<std::string>("Predictor") == "Tangent") predict(t0, t, bare, rec);
   assembly_->applyConstraints(*u_, t);
   if (std::getenv("CAPSTAN_CHECK_TANGENT")) checkTangent();
   // r0 is capped by the body's force scale c L^2: with a small penalty the bare
@@ -1233,10 +1268,13 @@ int Run::execute() {
       const double tEnd = std::min(tDone + h, rec.time);
       Vector uSaved(*u_, Teuchos::Copy);
       const auto mSaved = saveState();
+      std::vector<double> rotationsSaved;
+      for (const auto& core : assembly_->rigidCores()) rotationsSaved.push_back(core.rotation);
       std::string why;
       if (solveAt(tDone, tEnd, rec, why)) {
         previous_ = rcp(new Vector(uSaved, Teuchos::Copy));
         tPrevious_ = tDone;
+        previousRotation_ = rotationsSaved;
         tDone = tEnd;
         // History (friction) moves on to this converged state; the step's
         // last sub-step commits after the step's figures are taken, which

@@ -1,0 +1,171 @@
+// The rigid core: its follower kinematics (kernels/rigid_core.hpp) and its
+// coupling in the assembly (the chain rule at the core's face nodes), checked
+// against central differences of the assembled residual with the core's
+// translation and rotation free, a capstan pressing with friction, on 1 and 2
+// ranks. A rigid motion of body and core leaves no residual.
+#include <Tpetra_Core.hpp>
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "assembly.hpp"
+#include "scene.hpp"
+
+using namespace capstan;
+
+namespace {
+
+const char* kScene = R"xml(<ParameterList name="Scene">
+  <ParameterList name="Mesh">
+    <Parameter name="Type" type="string" value="Annulus"/>
+    <Parameter name="Inner Radius" type="double" value="1"/>
+    <Parameter name="Outer Radius" type="double" value="2"/>
+    <Parameter name="Length" type="double" value="0.6"/>
+    <Parameter name="Cells" type="Array(int)" value="{2, 12, 2}"/>
+  </ParameterList>
+  <ParameterList name="Material"><Parameter name="c" type="double" value="1.3"/></ParameterList>
+  <ParameterList name="Supports">
+    <ParameterList name="core">
+      <Parameter name="Face" type="string" value="inner"/>
+      <Parameter name="Type" type="string" value="Rigid Core"/>
+      <Parameter name="Axis Point" type="Array(double)" value="{0.1, -0.2, 0}"/>
+      <Parameter name="Axis Direction" type="Array(double)" value="{0.1, 0.2, 1}"/>
+      <Parameter name="Free Translation" type="string" value="xy"/>
+      <Parameter name="Force" type="Array(double)" value="{0.3, -0.5, 0}"/>
+      <Parameter name="Rotation" type="string" value="Free"/>
+      <Parameter name="Torque" type="double" value="0.2"/>
+    </ParameterList>
+  </ParameterList>
+  <ParameterList name="Capstans">
+    <ParameterList name="capstan">
+      <Parameter name="Radius" type="double" value="1"/>
+      <Parameter name="Axis Point" type="Array(double)" value="{0, -2.9, 0}"/>
+      <Parameter name="Angular Velocity" type="double" value="0.5"/>
+      <Parameter name="Contact Faces" type="string" value="outer"/>
+      <ParameterList name="Contact"><Parameter name="Penalty" type="double" value="0.05"/></ParameterList>
+      <ParameterList name="Friction">
+        <Parameter name="Law" type="string" value="Tanh"/>
+        <Parameter name="Coefficient" type="double" value="0.6"/>
+        <Parameter name="Regularization" type="double" value="0.5"/>
+      </ParameterList>
+    </ParameterList>
+  </ParameterList>
+  <ParameterList name="Output"><Parameter name="Directory" type="string" value="unused"/></ParameterList>
+</ParameterList>)xml";
+
+TEST(RigidCoreKernel, FollowerDerivativesMatchCentralDifferences) {
+  double d[3] = {0.2, -0.3, 0.9};
+  const double n = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  for (double& x : d) x /= n;
+  const double A[3] = {0.3, -0.1, 0.5}, T[3] = {0.05, -0.02, 0.01}, X[3] = {1.2, 0.7, -0.4};
+  const double theta = 0.7, h = 1e-6;
+  const auto f = kernels::coreFollower(A, d, T, theta, X);
+  const auto p = kernels::coreFollower(A, d, T, theta + h, X);
+  const auto m = kernels::coreFollower(A, d, T, theta - h, X);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR((p.u[i] - m.u[i]) / (2 * h), f.b[i], 1e-8);
+    EXPECT_NEAR((p.b[i] - m.b[i]) / (2 * h), f.w[i], 1e-8);
+  }
+  // A rotation keeps the distance to the axis and the position along it.
+  double r0[3], r[3], along0 = 0, along = 0, l0 = 0, l = 0;
+  for (int i = 0; i < 3; ++i) r0[i] = X[i] - A[i], r[i] = X[i] + f.u[i] - T[i] - A[i];
+  for (int i = 0; i < 3; ++i) along0 += r0[i] * d[i], along += r[i] * d[i];
+  for (int i = 0; i < 3; ++i) l0 += std::pow(r0[i] - along0 * d[i], 2), l += std::pow(r[i] - along * d[i], 2);
+  EXPECT_NEAR(along, along0, 1e-14);
+  EXPECT_NEAR(l, l0, 1e-13);
+  // A whole turn brings the node back (u = T).
+  const auto full = kernels::coreFollower(A, d, T, 2 * M_PI, X);
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(full.u[i], T[i], 1e-14);
+}
+
+// A smooth field on the free dofs, and values for the core's unknowns.
+void fill(const Assembly& a, const Mesh& mesh, Vector& v, double scale, double phase) {
+  auto d = v.getDataNonConst();
+  for (size_t n = 0; n < mesh.numOwnedNodes; ++n)
+    for (int i = 0; i < 3; ++i)
+      d[3 * n + i] = scale * std::sin(1.3 * mesh.X[3 * n] + 0.7 * mesh.X[3 * n + 1] + 2 * mesh.X[3 * n + 2] + i + phase);
+  if (a.ownedCoreDof(0, 0) >= 0) {
+    d[a.ownedCoreDof(0, 0)] = 0.4 * scale * std::cos(phase);
+    d[a.ownedCoreDof(0, 1)] = -0.3 * scale;
+    d[a.ownedCoreDof(0, 3)] = 2 * scale * std::sin(phase + 1);
+  }
+}
+
+TEST(RigidCore, CoupledTangentMatchesCentralDifferences) {
+  const Scene scene = parseScene(kScene, "rigid-core-test.xml", {}, "");
+  const auto& m = scene.mesh;
+  AnnulusGenerator gen(m.center, m.innerRadius, m.outerRadius, m.length, m.cells);
+  Mesh mesh = distributeMesh(gen, Tpetra::getDefaultComm());
+  Assembly assembly(mesh, scene);
+  const auto map = assembly.dofMap();
+  Vector u(map), v(map), f(map), fp(map), fm(map), Wv(map), trial(map);
+  fill(assembly, mesh, u, 0.02, 0.0);
+  assembly.setInterval(0.0, 0.5);
+  assembly.applyConstraints(u, 0.5);
+  fill(assembly, mesh, v, 1.0, 0.4);
+  {
+    auto d = v.getDataNonConst();
+    for (LO i = 0; i < LO(d.size()); ++i)
+      if (assembly.ownedConstrained(i)) d[i] = 0;
+  }
+  auto W = assembly.createMatrix();
+  ASSERT_TRUE(assembly.evaluate(u, &f, W.get()));
+  // The capstan presses and the core carries it: the state is a real test.
+  const auto& core = assembly.rigidCores().at(0);
+  EXPECT_GT(std::fabs(core.forceOnBody[1]), 1e-3);
+  EXPECT_GT(std::fabs(core.torqueOnBody), 1e-4);
+  EXPECT_GT(std::fabs(core.rotation), 1e-3);
+  W->apply(v, Wv);
+  const double h = 1e-6;
+  trial.update(1.0, u, h, v, 0.0);
+  ASSERT_TRUE(assembly.evaluate(trial, &fp, nullptr));
+  trial.update(1.0, u, -h, v, 0.0);
+  ASSERT_TRUE(assembly.evaluate(trial, &fm, nullptr));
+  Vector diff(map);
+  diff.update(1 / (2 * h), fp, -1 / (2 * h), fm, 0.0);
+  diff.update(-1.0, Wv, 1.0);
+  EXPECT_LT(diff.norm2(), 1e-6 * Wv.norm2()) << "|W v| = " << Wv.norm2();
+  // The core's rows on their own (rank 0 owns them).
+  double worst = 0, scale = 0;
+  {
+    auto dd = diff.getData();
+    auto wv = Wv.getData();
+    for (int j : {0, 1, 3}) {
+      const LO d = assembly.ownedCoreDof(0, j);
+      if (d < 0) continue;
+      worst = std::max(worst, std::fabs(dd[d]));
+      scale = std::max(scale, std::fabs(wv[d]));
+    }
+  }
+  if (assembly.ownedCoreDof(0, 0) >= 0) {
+    EXPECT_GT(scale, 1e-3);
+    EXPECT_LT(worst, 1e-6 * scale);
+  }
+}
+
+TEST(RigidCore, RigidMotionLeavesNoResidual) {
+  // Without the capstan and loads, turning and moving body and core together
+  // is a rigid motion: no stress, no reaction, no residual.
+  Scene scene = parseScene(kScene, "rigid-core-test.xml", {"Supports/core/Force={0,0,0}", "Supports/core/Torque=0"}, "");
+  scene.capstans.clear();
+  const auto& m = scene.mesh;
+  AnnulusGenerator gen(m.center, m.innerRadius, m.outerRadius, m.length, m.cells);
+  Mesh mesh = distributeMesh(gen, Tpetra::getDefaultComm());
+  Assembly assembly(mesh, scene);
+  Vector u(assembly.dofMap()), f(assembly.dofMap());
+  assembly.setInterval(0.0, 1.0);
+  {
+    auto d = u.getDataNonConst();
+    for (size_t n = 0; n < mesh.numOwnedNodes; ++n) d[3 * n] = 0.3, d[3 * n + 1] = -0.2;
+    if (assembly.ownedCoreDof(0, 0) >= 0) d[assembly.ownedCoreDof(0, 0)] = 0.3, d[assembly.ownedCoreDof(0, 1)] = -0.2;
+  }
+  assembly.rollWithCores(u, {0.9});  // the translated body turned with the core
+  ASSERT_TRUE(assembly.evaluate(u, &f, nullptr));
+  EXPECT_LT(f.normInf(), 1e-12);
+  const auto& core = assembly.rigidCores().at(0);
+  EXPECT_NEAR(core.rotation, 0.9, 1e-15);
+  for (int i = 0; i < 3; ++i) EXPECT_LT(std::fabs(core.forceOnBody[i]), 1e-12);
+  EXPECT_LT(std::fabs(core.torqueOnBody), 1e-12);
+}
+
+}  // namespace
