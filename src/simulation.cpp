@@ -181,7 +181,9 @@ class Run {
   // Anderson-accelerated.
   std::vector<double> multipliers(bool accelerated) const;
   std::vector<double> multiplierMap(bool accelerated) const;
-  void setMultipliers(const std::vector<double>& values, bool accelerated);
+  // keep: effects whose multipliers stay as they are.
+  void setMultipliers(const std::vector<double>& values, bool accelerated,
+                      const std::vector<const Effect*>& keep = {});
   // What a failed increment must undo: the multipliers and the effects'
   // history (committed by the converged sub-steps of a step that fails later).
   struct SolverState {
@@ -438,13 +440,17 @@ bool Run::solveAt(double t0, double t, StepRecord& rec, std::string& failure) {
     // Refresh p(x), v, contact pressures at the converged state.
     assembly_->evaluate(*u_, &f, nullptr);
     bool met = true;
+    std::vector<const Effect*> settled;  // plain-updated effects already within tolerance
     for (const auto& e : assembly_->effects()) {
       double v = 0;
       Teuchos::reduceAll(*comm_, Teuchos::REDUCE_MAX, e->constraintViolation(), Teuchos::outArg(v));
       if (e.get() == &assembly_->bricks()) rec.volumeChange = v;
       if (!opt_.quiet && rank0_ && std::getenv("CAPSTAN_NEWTON_LOG"))
         std::printf("    %s: %.3e (tolerance %.1e)\n", e->constraintName().c_str(), v, e->constraintTolerance());
-      if (v <= e->constraintTolerance()) continue;
+      if (v <= e->constraintTolerance()) {
+        settled.push_back(e.get());
+        continue;
+      }
       met = false;
       const auto* contact = dynamic_cast<const ContactEffect*>(e.get());
       if (contact && it >= contact->maxAugmentations()) {
@@ -456,7 +462,10 @@ bool Run::solveAt(double t0, double t, StepRecord& rec, std::string& failure) {
     }
     if (met) return true;
     setMultipliers(mixing.next(multipliers(true), multiplierMap(true)), true);
-    setMultipliers(multiplierMap(false), false);
+    // Contact and friction multipliers within their tolerance stay put: moving
+    // them anyway (stick/slip points flicker at the tolerance level) keeps
+    // changing the map the pressure loop's mixing works on, and it stalls.
+    setMultipliers(multiplierMap(false), false, settled);
   }
   failure = "augmentation loop did not meet the volume and contact tolerances in " +
             std::to_string(maxOuter) + " iterations";
@@ -485,10 +494,15 @@ std::vector<double> Run::multiplierMap(bool accelerated) const {
   return out;
 }
 
-void Run::setMultipliers(const std::vector<double>& values, bool accelerated) {
+void Run::setMultipliers(const std::vector<double>& values, bool accelerated,
+                         const std::vector<const Effect*>& keep) {
   size_t offset = 0;
   for (const auto& e : assembly_->effects()) {
     if (e->accelerated() != accelerated) continue;
+    if (std::find(keep.begin(), keep.end(), e.get()) != keep.end()) {
+      offset += e->multipliers().extent(0);
+      continue;
+    }
     auto view = e->multipliers();
     auto h = Kokkos::create_mirror_view(view);
     for (size_t i = 0; i < h.size(); ++i) h(i) = values[offset + i];
