@@ -382,9 +382,6 @@ ContactEffect::Figures ContactEffect::figures(const std::array<double, 3>& ref) 
       fig.maxPenetration = std::max(fig.maxPenetration, g);
       if (!(tn > 0)) continue;
       const double* e = &pts(f, q, kE);
-      ++fig.points;
-      fig.peakPressure = std::max(fig.peakPressure, tn);
-      fig.area += pts(f, q, kArea);
       // Force on the capstan at this point: -t w dA; its moment arm R e.
       double F[3];
       for (int i = 0; i < 3; ++i) F[i] = -tn * e[i] * pts(f, q, kWeight);
@@ -392,6 +389,13 @@ ContactEffect::Figures ContactEffect::figures(const std::array<double, 3>& ref) 
       const double tau[3] = {b[1] * e[2] - b[2] * e[1], b[2] * e[0] - b[0] * e[2],
                              b[0] * e[1] - b[1] * e[0]};
       fig.torque += settings_.radius * (F[0] * tau[0] + F[1] * tau[1] + F[2] * tau[2]);
+      // With a smoothed contact law, points just outside the nip keep a tiny
+      // pressure: they count as in contact (area, width) only where the exact
+      // law would press (tn > smoothing / 2).
+      if (!(tn > 0.5 * settings_.smoothing)) continue;
+      ++fig.points;
+      fig.peakPressure = std::max(fig.peakPressure, tn);
+      fig.area += pts(f, q, kArea);
       const double c = e[0] * ref[0] + e[1] * ref[1] + e[2] * ref[2];
       const double s = e[0] * side[0] + e[1] * side[1] + e[2] * side[2];
       const double angle = std::atan2(s, c);
@@ -571,8 +575,10 @@ FrictionEffect::Figures FrictionEffect::figures() const {
     for (int q = 0; q < nq; ++q) {
       const int state = int(pts(f, q, kState));
       if (state == 0) continue;
-      (state == 1 ? fig.stick : fig.slip) += 1;
       const double w = pts(f, q, kFWeight), tn = pts(f, q, kNormal);
+      // With a smoothed contact law, points just outside the nip keep a tiny
+      // pressure: counted as in contact only where the exact law would be.
+      if (tn > 0.5 * contact_.settings().smoothing) (state == 1 ? fig.stick : fig.slip) += 1;
       const double* t = &pts(f, q, kTraction);
       const double mag = std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
       fig.frictionIntegral += w * mag;
