@@ -233,4 +233,22 @@ for label, text in (("G1", G1),
     T.check(p.returncode == 0 and "WARNING" not in p.stderr,
             f"no warning for {label}: exit {p.returncode}, stderr {p.stderr.strip()[:200]!r}")
 T.check(listing(work) == {}, "validate writes nothing")
+# --- rigid cores: singular set-ups and misplaced parameters (on the roller slice) ----
+SLICE = T.input("pinch-roller-slice.xml")
+
+
+def roller_case(label, sets, needle):
+    case(label, SLICE, [SLICE, needle], args=[a for kv in sets for a in ("--set", kv)])
+
+
+roller_case("core: free rotation, no friction", ["Capstans/capstan/Friction/Law=None"], "Supports/core/Rotation")
+roller_case("core: free along the capstan axis", ["Supports/core/Free Translation=yz"], "Supports/core/Free Translation")
+roller_case("core: force along a held direction", ["Supports/core/Force={1, -0.25, 0}"], "Supports/core/Force")
+roller_case("core: torque without free rotation", ["Supports/core/Rotation=Fixed", "Supports/core/Torque=0.1"],
+            "Supports/core/Torque")
+roller_case("core: unknown rotation", ["Supports/core/Rotation=Spinning"], "Supports/core/Rotation")
+roller_case("core: zero axis", ["Supports/core/Axis Direction={0, 0, 0}"], "Supports/core/Axis Direction")
+roller_case("core: negative contact smoothing", ["Capstans/capstan/Contact/Smoothing=-1"], "Capstans/capstan/Contact/Smoothing")
+roller_case("rigid-core parameter on a Roller", ["Supports/front/Torque=1"], "Supports/front/Torque")
+
 T.finish()
