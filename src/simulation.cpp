@@ -251,6 +251,10 @@ class Run {
   std::map<std::string, std::pair<long, double>> effectOffset_;
   long numContactFaces_ = 0;  // global, each candidate face once
   double absTolerance_ = 0;
+  // A rigid core turns freely: the rolling measures (extrapolation, rolling
+  // first guess, settled multipliers) are on. Not checkpointed: a restarted
+  // rolling run starts them afresh and may differ from an uninterrupted one.
+  bool rolling_ = false;
   RCP<Vector> previous_;    // the state before the last converged increment (extrapolation)
   double tPrevious_ = 0;
   std::vector<double> previousRotation_;  // the cores' rotations in that state
@@ -343,12 +347,13 @@ bool Run::solveAt(double t0, double t, StepRecord& rec, std::string& failure) {
     assembly_->evaluate(plain, &f, nullptr);
     bare = f.norm2();
   }
-  // Extrapolation along the last converged increment: in steady rolling every
+  // Rolling only (a rigid core turning freely): extrapolation along the last
+  // converged increment. In steady rolling every
   // increment looks like the one before (the nip has moved on by one increment
   // of the roller's turn), which the linear response from a state at rest
   // cannot see. Kept when it beats the bare increment.
   bool extrapolated = false;
-  if (previous_ && tPrevious_ < t0) {
+  if (rolling_ && previous_ && tPrevious_ < t0) {
     Vector trial(*u_, Teuchos::Copy);
     trial.update(-(t - t0) / (t0 - tPrevious_), *previous_, 1.0 + (t - t0) / (t0 - tPrevious_));
     assembly_->applyConstraints(trial, t);
@@ -450,7 +455,7 @@ bool Run::solveAt(double t0, double t, StepRecord& rec, std::string& failure) {
       if (!opt_.quiet && rank0_ && std::getenv("CAPSTAN_NEWTON_LOG"))
         std::printf("    %s: %.3e (tolerance %.1e)\n", e->constraintName().c_str(), v, e->constraintTolerance());
       if (v <= e->constraintTolerance()) {
-        settled.push_back(e.get());
+        if (rolling_) settled.push_back(e.get());
         continue;
       }
       met = false;
@@ -464,9 +469,11 @@ bool Run::solveAt(double t0, double t, StepRecord& rec, std::string& failure) {
     }
     if (met) return true;
     setMultipliers(mixing.next(multipliers(true), multiplierMap(true)), true);
-    // Contact and friction multipliers within their tolerance stay put: moving
-    // them anyway (stick/slip points flicker at the tolerance level) keeps
-    // changing the map the pressure loop's mixing works on, and it stalls.
+    // Rolling: contact and friction multipliers within their tolerance stay
+    // put. Moving them anyway (points flicker at the tolerance level as they
+    // pass through the nip) keeps changing the map the pressure loop's mixing
+    // works on, and it stalls. Elsewhere every multiplier moves each pass (a
+    // symmetric problem then stays symmetric to round-off).
     setMultipliers(multiplierMap(false), false, settled);
   }
   failure = "augmentation loop did not meet the volume and contact tolerances in " +
@@ -1223,6 +1230,7 @@ int Run::execute() {
     throw InputError(scene_.file + ": " + e.what());
   }
   u_ = rcp(new Vector(assembly_->dofMap()));
+  for (const auto& core : assembly_->rigidCores()) rolling_ = rolling_ || core.free[3];
   double size2 = 0;
   for (int d = 0; d < 3; ++d) size2 = std::max(size2, std::pow(m.max[d] - m.min[d], 2));
   forceScale_ = scene_.c * size2;
