@@ -15,6 +15,8 @@
 #include <Thyra_StateFuncModelEvaluatorBase.hpp>
 #include <Thyra_TpetraThyraWrappers.hpp>
 
+#include <cstdio>
+
 #include "errors.hpp"
 
 namespace capstan {
@@ -274,7 +276,18 @@ NewtonSolver::NewtonSolver(Assembly& assembly, const Teuchos::ParameterList& sol
   builder.setPreconditioningStrategyFactory(Teuchos::abstractFactoryStd<PrecBase, Ifpack2Factory>(),
                                             "Ifpack2");
   Stratimikos::enableMueLu(builder);
-  impl_->strat = stratimikosParameters(solver, long(assembly.dofMap()->getGlobalNumElements()),
+  // Amesos2's KLU2 on several ranks gave wrong solutions with a rigid core's
+  // rows (Newton stalled where GMRES converged; docs/pinch-roller.md): there,
+  // Direct falls back to GMRES, and says so.
+  Teuchos::ParameterList chosen(solver);
+  const int ranks = assembly.dofMap()->getComm()->getSize();
+  if (ranks > 1 && !assembly.rigidCores().empty() && solver.get<std::string>("Linear Solver") == "Direct") {
+    chosen.set("Linear Solver", std::string("GMRES"));
+    if (assembly.dofMap()->getComm()->getRank() == 0)
+      std::fprintf(stderr, "capstan: note: Solver/Linear Solver = Direct is not reliable with a Rigid Core on %d "
+                           "ranks; using GMRES\n", ranks);
+  }
+  impl_->strat = stratimikosParameters(chosen, long(assembly.dofMap()->getGlobalNumElements()),
                                        assembly.dofMap()->getComm()->getSize(),
                                        solver.get<std::string>("Preconditioner") != "ILU" &&
                                                solver.get<std::string>("Preconditioner") != "Jacobi"
