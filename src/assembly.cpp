@@ -225,8 +225,13 @@ void Assembly::assembleCoreCoupling(FEMatrix& W) {
   // Accumulated per element in dense arrays, then added row by row.
   const auto& supportOf = constraints_.supportOf;
   const size_t nc = cores_.size(), nq = 4 * nc;
-  std::vector<double> toCore(nq * nodeDofs_, 0.0), fromCore(nq * nodeDofs_, 0.0), coreCore(nq * nq, 0.0);
-  std::vector<char> touched(nodeDofs_, 0);
+  // Scratch kept between assemblies (no allocation per evaluation).
+  auto& toCore = coupling_.toCore;
+  auto& fromCore = coupling_.fromCore;
+  auto& coreCore = coupling_.coreCore;
+  auto& touched = coupling_.touched;
+  toCore.assign(nq * nodeDofs_, 0.0), fromCore.assign(nq * nodeDofs_, 0.0), coreCore.assign(nq * nq, 0.0);
+  touched.assign(nodeDofs_, 0);
   for (size_t i = 0; i < effects_.size(); ++i) {
     const auto& L = effects_[i]->local();
     if (L.K.extent(0) == 0 || coupled_[i].empty()) continue;

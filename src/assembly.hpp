@@ -153,6 +153,10 @@ class Assembly {
   RCP<const Map> ownedDofMap_, overlapDofMap_;
   std::vector<LO> columnOf_;            // per assembly dof: local column of the matrix, or -1
   std::vector<std::vector<int>> coupled_;  // per effect: entities with a core face node
+  struct CouplingScratch {                  // assembleCoreCoupling's dense accumulators
+    std::vector<double> toCore, fromCore, coreCore;
+    std::vector<char> touched;
+  } coupling_;
   double time_ = 0;
   std::vector<std::unique_ptr<Effect>> effects_;
   BrickEffect* bricks_ = nullptr;

@@ -195,6 +195,11 @@ class Run {
   // Why a step may have no equilibrium at all: a core's applied torque beyond
   // what friction in the nip can carry. Empty when no such core.
   std::string brakeDiagnosis() const;
+  // The core's angular velocity when its outer (undeformed) surface rolls
+  // without slip on the first spinning capstan (external contact: it turns
+  // against the capstan); 0 when there is none. The speed ratio is the core's
+  // angular velocity over this.
+  double noSlipAngularVelocity(const RigidCore& core) const;
   // Element stress (6 per element), von Mises and pressure on the host, at the
   // last evaluated state.
   struct ElementFields {
@@ -378,15 +383,7 @@ bool Run::solveAt(double t0, double t, StepRecord& rec, std::string& failure) {
         if (previous_ && tPrevious_ < t0) {
           omega = (core.rotation - previousRotation_[&core - assembly_->rigidCores().data()]) / (t0 - tPrevious_);
         } else {
-          for (const auto& c : scene_.capstans) {
-            if (c.angularVelocity == 0 || scene_.mesh.type != "Annulus") continue;
-            const auto& b = c.axisDirection;
-            const double nb = std::sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
-            const auto& d = core.axisDirection;
-            omega = -c.angularVelocity * c.radius * (d[0] * b[0] + d[1] * b[1] + d[2] * b[2]) / nb /
-                    scene_.mesh.outerRadius;
-            break;
-          }
+          omega = noSlipAngularVelocity(core);
         }
       }
       dTheta.push_back(omega * (t - t0));
@@ -597,6 +594,19 @@ StateFigures Run::figures() {
   return s;
 }
 
+double Run::noSlipAngularVelocity(const RigidCore& core) const {
+  if (scene_.mesh.type != "Annulus") return 0;
+  for (const auto& c : scene_.capstans) {
+    if (c.angularVelocity == 0) continue;
+    const auto& b = c.axisDirection;
+    const double nb = std::sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+    const auto& d = core.axisDirection;
+    const double along = (d[0] * b[0] + d[1] * b[1] + d[2] * b[2]) / nb;
+    return -c.angularVelocity * c.radius * along / scene_.mesh.outerRadius;
+  }
+  return 0;
+}
+
 std::string Run::brakeDiagnosis() const {
   auto brief = [](double x) {
     std::ostringstream o;
@@ -655,20 +665,9 @@ void Run::recordStep(StepRecord& rec) {
         if (p.name == core.name) before = p.rotation;
     }
     sr.angularVelocity = (core.rotation - before) / (rec.time - tBefore);
-    // Against the first spinning capstan: surface speeds omega R, the roller's
-    // at its outer (undeformed) radius; positive when the nip's surfaces move
-    // together (external contact: the roller turns against the capstan).
-    if (scene_.mesh.type != "Annulus") continue;
-    for (const auto& c : scene_.capstans) {
-      if (c.angularVelocity == 0) continue;
-      const auto& b = c.axisDirection;
-      const double nb = std::sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
-      const auto& d = core.axisDirection;
-      const double along = (d[0] * b[0] + d[1] * b[1] + d[2] * b[2]) / nb;
-      sr.hasSpeedRatio = true;
-      sr.speedRatio = -sr.angularVelocity * scene_.mesh.outerRadius * along / (c.angularVelocity * c.radius);
-      break;
-    }
+    const double rolling = noSlipAngularVelocity(core);
+    sr.hasSpeedRatio = rolling != 0;
+    if (sr.hasSpeedRatio) sr.speedRatio = sr.angularVelocity / rolling;
   }
   for (size_t i = 0; i < assembly_->contacts().size(); ++i)
     rec.capstans.push_back(capstanFigures(*assembly_->contacts()[i], assembly_->frictions()[i]));
