@@ -158,7 +158,16 @@ ParameterList validParameters() {
           "Auto | ILU | Jacobi | MueLu | None (Ifpack2 RILUK per rank, Jacobi relaxation; MueLu smoothed "
           "aggregation with the rigid-body modes). Auto: MueLu from 1000 dofs, ILU below");
   sol.set("ILU Level", 1, "ILU: level of fill (>= 0)");
+  sol.set("Preconditioner Reuse", std::string("Adaptive"),
+          "Adaptive | None. Adaptive: Newton keeps its preconditioner across iterations, load "
+          "steps and pressure passes, and rebuilds it when a Krylov solve needs more than twice "
+          "the iterations (+10) of the first solve after the last build, or hits its limit; "
+          "None: a new one every Newton iteration");
   sol.set("Linear Tolerance", 1e-10, "Relative residual of each linear solve (0 < tol < 1)");
+  sol.set("Linear Tolerance Method", std::string("Adaptive"),
+          "Adaptive | Fixed. Adaptive: Eisenstat-Walker forcing terms (each Krylov solve only as "
+          "tight as Newton's progress needs, never tighter than Linear Tolerance); Fixed: every "
+          "Krylov solve to Linear Tolerance. Direct solves are exact either way");
   sol.set("Max Linear Iterations", 2000, "Krylov iteration limit per linear solve");
   sol.set("Newton Relative Tolerance", 1e-10, "Converged when |R| <= this x |R| at the step's start");
   sol.set("Newton Absolute Tolerance", 0.0, "Converged when |R| <= this; 0 = 1e-13 x c x (body size)^2");
@@ -959,6 +968,8 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
   oneOf("Preconditioner", {"Auto", "ILU", "Jacobi", "MueLu", "None"});
   oneOf("Line Search", {"Backtrack", "Polynomial", "Full Step"});
   oneOf("Predictor", {"Tangent", "Previous"});
+  oneOf("Linear Tolerance Method", {"Adaptive", "Fixed"});
+  oneOf("Preconditioner Reuse", {"Adaptive", "None"});
   for (const char* n : {"Linear Tolerance", "Newton Relative Tolerance", "Volume Tolerance"}) {
     const double x = sol.get<double>(n);
     if (!(x > 0 && x < 1)) v.fail(std::string("Solver/") + n, "must be in (0, 1)");
