@@ -116,8 +116,26 @@ class BodyModel : public Thyra::StateFuncModelEvaluatorBase<double> {
     outArgs_ = out;
     nominal_ = in;
   }
+  // The initial guess holds the prescribed values on the constrained dofs;
+  // Newton moves only the free ones. (A Krylov solve to a loose tolerance,
+  // as Eisenstat-Walker asks for, leaves small non-zero components on the
+  // constrained rows of the Newton step; their residual is zero, so Newton
+  // would never correct that drift, and the supports would move.)
   void setInitialGuess(const RCP<Vector>& u) {
     nominal_.set_x(Thyra::createVector(u, space_));
+    if (pinned_.is_null()) {
+      pinned_ = rcp(new Vector(u->getMap()));
+      trial_ = rcp(new Vector(u->getMap()));
+      for (LO d = 0; d < LO(u->getLocalLength()); ++d)
+        if (assembly_.ownedConstrained(d)) constrained_.push_back(d);
+    }
+    pinned_->update(1.0, *u, 0.0);
+  }
+  // Puts the prescribed values back on u's constrained dofs.
+  void pin(Vector& u) const {
+    auto to = u.getDataNonConst();
+    auto from = pinned_->getData();
+    for (LO d : constrained_) to[d] = from[d];
   }
   RCP<const Thyra::VectorSpaceBase<double>> get_x_space() const override { return space_; }
   RCP<const Thyra::VectorSpaceBase<double>> get_f_space() const override { return space_; }
@@ -135,7 +153,9 @@ class BodyModel : public Thyra::StateFuncModelEvaluatorBase<double> {
   Thyra::ModelEvaluatorBase::OutArgs<double> createOutArgsImpl() const override { return outArgs_; }
   void evalModelImpl(const Thyra::ModelEvaluatorBase::InArgs<double>& in,
                      const Thyra::ModelEvaluatorBase::OutArgs<double>& out) const override {
-    auto u = ConverterT::getConstTpetraVector(in.get_x());
+    trial_->update(1.0, *ConverterT::getConstTpetraVector(in.get_x()), 0.0);
+    pin(*trial_);
+    const RCP<const Vector> u = trial_;
     RCP<Vector> f = out.get_f().is_null() ? Teuchos::null : ConverterT::getTpetraVector(out.get_f());
     RCP<FEMatrix> W;
     if (!out.get_W_op().is_null())
@@ -148,6 +168,8 @@ class BodyModel : public Thyra::StateFuncModelEvaluatorBase<double> {
   RCP<const Thyra::VectorSpaceBase<double>> space_;
   Thyra::ModelEvaluatorBase::InArgs<double> inArgs_, nominal_;
   Thyra::ModelEvaluatorBase::OutArgs<double> outArgs_;
+  RCP<Vector> pinned_, trial_;
+  std::vector<LO> constrained_;
 };
 
 // Records |R| after every Newton iteration, and tells the lag policy how many
@@ -450,6 +472,7 @@ NewtonResult NewtonSolver::solve(Vector& u, double tolerance) {
     const auto& x = dynamic_cast<const NOX::Thyra::Vector&>(g.getX());
     auto sol = ConverterT::getConstTpetraVector(x.getThyraRCPVector());
     u.update(1.0, *sol, 0.0);
+    impl_->model->pin(u);
     r.iterations = solver->getNumIterations();
     r.residualNorm = g.getNormF();
   } catch (const std::exception& e) {

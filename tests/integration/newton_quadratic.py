@@ -6,7 +6,8 @@ solve:   newton |R|: r0 r1 r2 ...  (N linear)
 as given (Auto linear solver: direct on one rank, tangent predictor), with
 Solver/Predictor=Previous (Newton starts farther from the solution: longer
 histories), and with Solver/Linear Solver=GMRES (the iterative path that
-distributed runs take).
+distributed runs take; with Linear Tolerance Method = Fixed, since the default
+Eisenstat-Walker forcing terms make Newton superlinear by design).
 
 Criterion. Quadratic convergence means r_{k+1} <= C r_k^2 with C bounded as
 r_k -> 0; an inconsistent tangent gives linear convergence, r_{k+1} ~ rho r_k,
@@ -69,7 +70,7 @@ def parse(stdout):
 
 total_pairs = 0
 for label, sets in (("as given", []), ("Predictor=Previous", ["Solver/Predictor=Previous"]),
-                    ("GMRES", ["Solver/Linear Solver=GMRES"])):
+                    ("GMRES", ["Solver/Linear Solver=GMRES", "Solver/Linear Tolerance Method=Fixed"])):
     print(f"\n  --- shear.xml, {label}")
     p, s, out = T.run_scene(scene, f"shear-{len(sets)}-{label.split('=')[0].replace(' ', '')}", sets=sets,
                             env={"CAPSTAN_NEWTON_LOG": "1"}, quiet=False)
