@@ -306,9 +306,11 @@ void Run::predict(double t0, double t1, double bareResidual, StepRecord& rec) {
     trial.update(alpha, du, 1.0, z, 1.0);
     assembly_->applyConstraints(trial, t1);
     const bool valid = assembly_->evaluate(trial, &f, nullptr);
-    if (std::getenv("CAPSTAN_NEWTON_LOG") && rank0_ && !opt_.quiet) std::printf("    predictor alpha %g valid %d |R| %.3e bare %.3e\n", alpha, int(valid), f.norm2(), bareResidual);
+    const double norm = f.norm2();  // collective: every rank
+    if (std::getenv("CAPSTAN_NEWTON_LOG") && rank0_ && !opt_.quiet)
+      std::printf("    predictor alpha %g valid %d |R| %.3e bare %.3e\n", alpha, int(valid), norm, bareResidual);
     if (!valid) continue;  // inverts an element
-    if (f.norm2() < bareResidual) {
+    if (norm < bareResidual) {
       u_->update(1.0, trial, 0.0);
       return;
     }
@@ -364,9 +366,10 @@ bool Run::solveAt(double t0, double t, StepRecord& rec, std::string& failure) {
     trial.update(-(t - t0) / (t0 - tPrevious_), *previous_, 1.0 + (t - t0) / (t0 - tPrevious_));
     assembly_->applyConstraints(trial, t);
     const bool valid = assembly_->evaluate(trial, &f, nullptr);
+    const double norm = f.norm2();  // collective: every rank
     if (std::getenv("CAPSTAN_NEWTON_LOG") && rank0_ && !opt_.quiet)
-      std::printf("    extrapolated: valid %d |R| %.3e bare %.3e\n", int(valid), f.norm2(), bare);
-    if (valid && f.norm2() < bare) {
+      std::printf("    extrapolated: valid %d |R| %.3e bare %.3e\n", int(valid), norm, bare);
+    if (valid && norm < bare) {
       u_->update(1.0, trial, 0.0);
       extrapolated = true;
     }
