@@ -446,6 +446,10 @@ int NewtonSolver::linearSolve(const RCP<FEMatrix>& W, const Vector& b, Vector& x
   return iterations;
 }
 
+void NewtonSolver::rebuildPreconditioner() {
+  if (!impl_->newtonPrecFactory.is_null()) impl_->newtonPrecFactory->requestRebuild();
+}
+
 double NewtonSolver::linearSolveSeconds() const { return impl_->linearSeconds; }
 double NewtonSolver::preconditionerSeconds() const { return impl_->preconditionerSeconds; }
 const Teuchos::ParameterList& NewtonSolver::linearSolverParameters() const { return impl_->strat; }

@@ -33,6 +33,9 @@ class NewtonSolver {
   // One linear solve W x = b with the configured solver (x: initial guess in,
   // solution out). Returns the Krylov iterations, or -1 if it failed.
   int linearSolve(const RCP<FEMatrix>& W, const Vector& b, Vector& x);
+  // Newton's next linear solve builds a new preconditioner (with Solver/
+  // Preconditioner Reuse = Adaptive it is otherwise kept while it works).
+  void rebuildPreconditioner();
   double linearSolveSeconds() const;
   // The part of linearSolveSeconds() spent setting up preconditioners.
   double preconditionerSeconds() const;

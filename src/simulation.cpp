@@ -1317,6 +1317,9 @@ int Run::execute() {
   bool ok = true;
   for (int step = firstStep; step <= N && ok; ++step) {
     const auto tStep = Clock::now();
+    // A reused preconditioner starts each step afresh, so a run restarted at
+    // any step repeats the uninterrupted run's arithmetic exactly.
+    newton_->rebuildPreconditioner();
     StepRecord rec;
     rec.step = step;
     rec.time = step * dt;

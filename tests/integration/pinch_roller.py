@@ -69,9 +69,13 @@ for st in free["steps"]:
     T.check(abs(cap["force"][0]) < 0.05 * mu * F,
             f"free step {st['step']}: net tangential nip force {cap['force'][0]:.3g} << mu N = {mu * F}")
 # GMRES + ILU on 2 ranks: the distributed KLU2 solve gave wrong Newton directions
-# with the core's rows (docs/pinch-roller.md).
+# with the core's rows (docs/pinch-roller.md). Every Krylov solve to 1e-12
+# (Fixed): with the default Eisenstat-Walker tolerances each step ends just
+# below the Newton tolerance, and the free rotation, held only by friction,
+# then differs by ~1e-5 between rank counts (docs/performance.md).
 two = run(slice_scene, "free-2ranks", ranks=2,
-          sets=["Solver/Linear Solver=GMRES", "Solver/Preconditioner=ILU", "Solver/Linear Tolerance=1e-12"])
+          sets=["Solver/Linear Solver=GMRES", "Solver/Preconditioner=ILU", "Solver/Linear Tolerance=1e-12",
+                "Solver/Linear Tolerance Method=Fixed"])
 for a, b in zip(free["steps"], two["steps"]):
     ca, cb = a["supports"]["core"], b["supports"]["core"]
     T.check(abs(ca["rotation"] - cb["rotation"]) < 1e-8 * abs(ca["rotation"]) and
