@@ -74,10 +74,11 @@ double fmaPeak() {
 //   pass 1, per Gauss point: reference gradients 434 (shape functions 120,
 //   dX/dxi 144, inverse 50, D 120), F 144, det 14, volume 2  -> 594
 //   pass 2, per Gauss point: inverse 50, d and G 240, R and g 168  -> 458
-//     tangent: H, e 96; per node pair D_a.D_b 5 + 1, 9 entries x 4 + 3 -> 64 x 45
-//   g g^T / (eps V): 576 x 3.
+//     tangent: H, e 96; S_ab for the 36 pairs b >= a, 7 each  -> 348
+//   after the Gauss points: T and the H d products 2 x (24 x 24 x 8 x 2),
+//   g g^T 576 + 24, T and S added 576 + 192.
 constexpr double kBrickFlopsResidual = 8 * 594 + 8 * 458;
-constexpr double kBrickFlopsTangent = kBrickFlopsResidual + 8 * (96 + 64 * 45) + 576 * 3;
+constexpr double kBrickFlopsTangent = kBrickFlopsResidual + 8 * (96 + 348) + 2 * 9216 + 600 + 768;
 // Contact face, 2x2 Gauss, every point in contact (kernels/contact.hpp), per point:
 //   area elements 2 x 60, shape 30, position 24, gap 30, traction 10,
 //   residual 12 x 4, C 3x3 30, tangent 16 node pairs x 9 x 4  -> ~870

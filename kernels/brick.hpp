@@ -54,11 +54,14 @@ KOKKOS_INLINE_FUNCTION double brickVolume(const double X[8][3], const double x[8
 // Two passes over the 8 Gauss points: the first computes F and the volume v
 // (the pressure p(v) enters every term of the second), keeping the reference
 // gradients and F so that the second pass does not recompute them. The
-// tangent's inner loop uses per-node vectors scaled once per Gauss point, so
-// each of the 576 entries costs 2 multiply-adds (plus the diagonal):
-//   K[ai][bk] += H_a,i d_b,k + d_b,i e_a,k + delta_ik s_ab,
-//   H_a = wJ (2c G_a - q d_a),  e_a = wJ q d_a,  s_ab = wJ 2c D_a.D_b.
-// (A component-major variant with 8-wide inner loops measured 30% slower.)
+// second pass keeps, per Gauss point, three 24-vectors (dof index ai):
+//   d_a = F^{-T} D_a,  H_a = wJ (2c G_a - q d_a),  e_a = wJ q d_a,
+// and the tangent is then assembled from small matrix products over the
+// Gauss points, whose 24-wide rows the compiler vectorises:
+//   K[ai][bk] = sum_gp H_ai d_bk + T[ak][bi] + delta_ik S_ab + g_ai g_bk/(eps V)
+//   T[ak][bi] = sum_gp e_ak d_bi,   S_ab = sum_gp wJ 2c D_a.D_b.
+// (Accumulating the 3x3 node-pair blocks per Gauss point instead, with
+// 3-wide inner loops, measured 1.4x slower.)
 KOKKOS_INLINE_FUNCTION void brickResidualTangent(const double X[8][3], const double x[8][3],
                                                  double V, double pbar, double c, double eps,
                                                  double* R, double* K, BrickState& out) {
@@ -79,49 +82,56 @@ KOKKOS_INLINE_FUNCTION void brickResidualTangent(const double X[8][3], const dou
   const double q = p + 2 * c;  // sigma = -q I + 2c B
   double g[24];
   for (int r = 0; r < 24; ++r) R[r] = g[r] = 0;
-  if (wantTangent)
-    for (int r = 0; r < 576; ++r) K[r] = 0;
+  double dq[8][24], Hq[8][24], eq[8][24], S[8][8];
+  for (int a = 0; a < 8; ++a)
+    for (int b = 0; b < 8; ++b) S[a][b] = 0;
   for (int gp = 0; gp < 8; ++gp) {
     const double(*D)[3] = Dq[gp];
     const double(*F)[3] = Fq[gp];
     double Finv[3][3];
     const double wJ = wq[gp] * inverse3(Fq[gp], Finv);
-    double d[8][3], G[8][3];  // spatial gradients F^{-T} D_a and push-forward F D_a
+    const double c2 = 2 * c * wJ, qw = q * wJ;
+    double* d = dq[gp];
     for (int a = 0; a < 8; ++a)
       for (int i = 0; i < 3; ++i) {
-        d[a][i] = Finv[0][i] * D[a][0] + Finv[1][i] * D[a][1] + Finv[2][i] * D[a][2];
-        G[a][i] = F[i][0] * D[a][0] + F[i][1] * D[a][1] + F[i][2] * D[a][2];
-      }
-    for (int a = 0; a < 8; ++a)
-      for (int i = 0; i < 3; ++i) {
-        R[3 * a + i] += wJ * (2 * c * G[a][i] - q * d[a][i]);
-        g[3 * a + i] += wJ * d[a][i];
+        // spatial gradient F^{-T} D_a and push-forward F D_a
+        const double da = Finv[0][i] * D[a][0] + Finv[1][i] * D[a][1] + Finv[2][i] * D[a][2];
+        const double Ga = F[i][0] * D[a][0] + F[i][1] * D[a][1] + F[i][2] * D[a][2];
+        d[3 * a + i] = da;
+        R[3 * a + i] += wJ * (2 * c * Ga - q * da);
+        g[3 * a + i] += wJ * da;
+        if (!wantTangent) continue;
+        // dP/dF contracted with D_a, D_b (P = 2cJ F - qJ F^{-T}, q at fixed p):
+        //   wJ [2c (G_a,i d_b,k + delta_ik D_a.D_b) - q (d_a,i d_b,k - d_a,k d_b,i)]
+        Hq[gp][3 * a + i] = c2 * Ga - qw * da;
+        eq[gp][3 * a + i] = qw * da;
       }
     if (!wantTangent) continue;
-    // dP/dF contracted with D_a, D_b (P = 2cJ F - qJ F^{-T}, q at fixed p):
-    //   wJ [2c (G_a,i d_b,k + delta_ik D_a.D_b) - q (d_a,i d_b,k - d_a,k d_b,i)]
-    const double c2 = 2 * c * wJ, qw = q * wJ;
-    double H[8][3], e[8][3];
     for (int a = 0; a < 8; ++a)
-      for (int i = 0; i < 3; ++i) {
-        H[a][i] = c2 * G[a][i] - qw * d[a][i];
-        e[a][i] = qw * d[a][i];
-      }
-    for (int a = 0; a < 8; ++a)
-      for (int b = 0; b < 8; ++b) {
-        const double s = c2 * (D[a][0] * D[b][0] + D[a][1] * D[b][1] + D[a][2] * D[b][2]);
-        for (int i = 0; i < 3; ++i) {
-          double* row = K + (3 * a + i) * 24 + 3 * b;
-          for (int k = 0; k < 3; ++k) row[k] += H[a][i] * d[b][k] + d[b][i] * e[a][k];
-          row[i] += s;
-        }
-      }
+      for (int b = a; b < 8; ++b) S[a][b] += c2 * (D[a][0] * D[b][0] + D[a][1] * D[b][1] + D[a][2] * D[b][2]);
   }
-  // p(x) enters R_u as -p g: condensed term g g^T / (eps V).
+  if (!wantTangent) return;
+  // T first (its rows are read transposed within node-pair blocks), then each
+  // row of K in one sweep; p(x) enters R_u as -p g: condensed g g^T / (eps V).
+  double T[24][24];
+  for (int r = 0; r < 24; ++r) {
+    for (int t = 0; t < 24; ++t) T[r][t] = 0;
+    for (int gp = 0; gp < 8; ++gp)
+      for (int t = 0; t < 24; ++t) T[r][t] += eq[gp][r] * dq[gp][t];
+  }
   const double s = 1.0 / (eps * V);
-  if (wantTangent)
-    for (int r = 0; r < 24; ++r)
-      for (int t = 0; t < 24; ++t) K[r * 24 + t] += s * g[r] * g[t];
+  for (int r = 0; r < 24; ++r) {
+    const int a = r / 3, i = r % 3;
+    double row[24];
+    for (int t = 0; t < 24; ++t) row[t] = s * g[r] * g[t];
+    for (int gp = 0; gp < 8; ++gp)
+      for (int t = 0; t < 24; ++t) row[t] += Hq[gp][r] * dq[gp][t];
+    for (int b = 0; b < 8; ++b) {
+      for (int k = 0; k < 3; ++k) row[3 * b + k] += T[3 * a + k][3 * b + i];
+      row[3 * b + i] += b >= a ? S[a][b] : S[b][a];
+    }
+    for (int t = 0; t < 24; ++t) K[r * 24 + t] = row[t];
+  }
 }
 
 

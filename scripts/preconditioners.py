@@ -1,61 +1,144 @@
 #!/usr/bin/python3
-"""Preconditioners compared on G1 (inputs/seed/g1.xml), refined 1x and 2x, and the
-pressure penalty eps1 swept on the 1x mesh: Newton and linear iterations, linear
-iterations per Newton iteration, preconditioner set-up and linear-solve seconds.
+"""Linear solvers compared on G1 (inputs/seed/g1.xml, 5 load steps), refined
+1x, 2x, 4x (cells multiplied in every direction), GMRES with each
+preconditioner; then the pressure penalty eps1 swept from 1e-13 to 1e-1 with
+the default solver, and the solver's two cost savers (Eisenstat-Walker
+tolerances, a reused preconditioner) switched off one at a time.
 
-    scripts/preconditioners.py [--out out/preconditioners] [--ranks 1] [--factors 1,2]
+    scripts/preconditioners.py [--out out/preconditioners] [--factors 1,2,4]
+                               [--ranks 1] [--quick]
 
-Runs whose summary.json exists are reused. Prints a markdown table (also
-written to OUT/preconditioners.md).
+--quick: the 1x and 2x meshes only. Runs whose summary.json exists are
+reused. Writes OUT/preconditioners.md and .csv (one row per run) and prints
+the table: Newton and linear iterations, linear iterations per Newton
+iteration, set-up and solve seconds, the capstan force (every run must give
+the same answer).
 """
 import argparse
+import csv
 import json
 import os
+import re
 import subprocess
+import sys
 
 ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+root = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
 ap.add_argument("--out", default="out/preconditioners")
-ap.add_argument("--capstan", default=os.path.join(os.path.dirname(__file__), "..", "build", "capstan"))
-ap.add_argument("--factors", default="1,2")
+ap.add_argument("--capstan", default=os.path.join(root, "build", "capstan"))
+ap.add_argument("--factors", default="1,2,4")
 ap.add_argument("--ranks", type=int, default=1)
+ap.add_argument("--quick", action="store_true")
 args = ap.parse_args()
+factors = [1, 2] if args.quick else [int(x) for x in args.factors.split(",")]
+env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
 
-runs = []
-for f in [int(x) for x in args.factors.split(",")]:
-    cells = f"{{{14 * f},{4 * f},{6 * f}}}"
-    precs = [("ILU", ["Solver/ILU Level=1"]), ("MueLu", [])]
-    if f == 1:  # far slower on the 1x mesh already (453 and 196 linear its per Newton)
-        precs += [("ILU(0)", ["Solver/Preconditioner=ILU", "Solver/ILU Level=0"]), ("Jacobi", [])]
-    for name, extra in precs:
-        sets = [f"Mesh/Cells={cells}", "Solver/Linear Solver=GMRES"]
-        if not name.startswith("ILU("):
-            sets.append(f"Solver/Preconditioner={name}")
-        runs.append((f"{f}x {name}", f"g1-{f}x-{name}".replace("(", "").replace(")", ""), sets + extra))
+
+def ifpack2(prec_type, settings):
+    """A Solver/Stratimikos sublist that sets Ifpack2's type and settings."""
+    items = "".join(f'<Parameter name="{k}" type="{t}" value="{v}"/>' for k, t, v in settings)
+    return ('<ParameterList name="Preconditioner Types"><ParameterList name="Ifpack2">'
+            f'<Parameter name="Prec Type" type="string" value="{prec_type}"/>'
+            f'<ParameterList name="Ifpack2 Settings">{items}</ParameterList></ParameterList></ParameterList>')
+
+
+# name: (capstan Solver parameters, extra Solver/Stratimikos XML)
+PRECONDITIONERS = {
+    "MueLu SA": ({"Preconditioner": "MueLu"}, ""),
+    "ILU(1)": ({"Preconditioner": "ILU", "ILU Level": "1"}, ""),
+    "ILU(0)": ({"Preconditioner": "ILU", "ILU Level": "0"}, ""),
+    "Chebyshev(3)": ({"Preconditioner": "Jacobi"},
+                     ifpack2("CHEBYSHEV", [("chebyshev: degree", "int", 3)])),
+    "SGS x2": ({"Preconditioner": "Jacobi"},
+               ifpack2("RELAXATION", [("relaxation: type", "string", "Symmetric Gauss-Seidel"),
+                                      ("relaxation: sweeps", "int", 2)])),
+    "Jacobi": ({"Preconditioner": "Jacobi"}, ""),
+}
+
+
+def scene_with(path, solver, stratimikos):
+    """G1 with a Solver sublist written into it (a copy under OUT/scenes)."""
+    params = "".join(f'<Parameter name="{k}" type="{"int" if k == "ILU Level" else "string"}" value="{v}"/>'
+                     for k, v in solver.items())
+    strat = f'<ParameterList name="Stratimikos">{stratimikos}</ParameterList>' if stratimikos else ""
+    text = open(os.path.join(root, "inputs/seed/g1.xml")).read()
+    text = text.replace('<ParameterList name="Output">',
+                        f'<ParameterList name="Solver">{params}{strat}</ParameterList>\n  <ParameterList name="Output">')
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(path, "w") as fh:
+        fh.write(text)
+    return path
+
+
+runs = []  # (group, label, tag, solver, stratimikos, sets)
+for f in factors:
+    cells = f"Mesh/Cells={{{14 * f},{4 * f},{6 * f}}}"
+    for name, (solver, strat) in PRECONDITIONERS.items():
+        # Point relaxations need hundreds of iterations per Newton step already on 1x.
+        if f > 2 and name in ("Jacobi", "ILU(0)"):
+            continue
+        runs.append(("preconditioner", f"{f}x {name}", f"g1-{f}x-" + re.sub(r"[^A-Za-z0-9]+", "", name),
+                     dict(solver, **{"Linear Solver": "GMRES"}), strat, [cells]))
 for eps in ("1e-13", "1e-8", "1e-3", "1e-1"):
-    runs.append((f"1x MueLu eps1={eps}", f"g1-1x-MueLu-eps1-{eps}",
-                 ["Solver/Linear Solver=GMRES", "Solver/Preconditioner=MueLu", f"Material/Pressure Penalty={eps}"]))
+    runs.append(("eps1", f"1x eps1 = {eps}", f"g1-1x-eps1-{eps}", {"Linear Solver": "GMRES", "Preconditioner": "MueLu"},
+                 "", [f"Material/Pressure Penalty={eps}"]))
+for f in [x for x in factors if x <= 2]:
+    for label, extra in (("fixed tolerance", {"Linear Tolerance Method": "Fixed"}),
+                         ("new preconditioner every Newton iteration", {"Preconditioner Reuse": "None"}),
+                         ("both", {"Linear Tolerance Method": "Fixed", "Preconditioner Reuse": "None"})):
+        runs.append(("savers", f"{f}x MueLu, {label}", f"g1-{f}x-savers-" + re.sub(r"[^A-Za-z]+", "", label),
+                     dict({"Linear Solver": "GMRES", "Preconditioner": "MueLu"}, **extra), "",
+                     [f"Mesh/Cells={{{14 * f},{4 * f},{6 * f}}}"]))
 
-lines = ["| run | ranks | dofs | Newton its | linear its | linear its / Newton | precond. set-up s | linear solve s | total s | converged |",
-         "|---|---|---|---|---|---|---|---|---|---|"]
-for label, tag, sets in runs:
+rows = []
+for group, label, tag, solver, strat, sets in runs:
     out = os.path.join(args.out, f"{tag}-r{args.ranks}")
-    if not os.path.isfile(os.path.join(out, "summary.json")):
-        cmd = [args.capstan, "run", "inputs/seed/g1.xml", "--output", out, "--quiet"]
+    summary = os.path.join(out, "summary.json")
+    if not os.path.isfile(summary):
+        scene = scene_with(os.path.join(args.out, "scenes", tag + ".xml"), solver, strat)
+        cmd = [args.capstan, "run", scene, "--output", out, "--quiet", "--set", "Output/Write Fields=false"]
         for s in sets:
             cmd += ["--set", s]
         if args.ranks > 1:
-            cmd = ["mpiexec", "--allow-run-as-root", "--oversubscribe", "-n", str(args.ranks)] + cmd
+            cmd = ["mpiexec", "--oversubscribe", "-n", str(args.ranks)] + cmd
         print("  " + label, flush=True)
-        subprocess.run(cmd, capture_output=True)
-    with open(os.path.join(out, "summary.json")) as fh:
+        run = subprocess.run(cmd, env=env, capture_output=True, text=True)
+        if not os.path.isfile(summary):
+            sys.exit(f"preconditioners.py: {label} wrote no summary.json (exit {run.returncode}):\n{run.stderr}")
+    with open(summary) as fh:
         s = json.load(fh)
     newton = sum(st["newton_iterations"] for st in s["steps"])
     linear = sum(st["linear_iterations"] for st in s["steps"])
     t = s["timing"]
-    lines.append(f"| {label} | {args.ranks} | {s['mesh']['dofs']} | {newton} | {linear} | {linear / max(newton, 1):.1f} | "
-                 f"{t.get('preconditioner_setup', 0):.1f} | {t['linear_solve']:.1f} | {t['total']:.1f} | {s['converged']} |")
-text = "\n".join(lines)
+    rows.append({"group": group, "run": label, "ranks": args.ranks, "dofs": s["mesh"]["dofs"], "newton": newton,
+                 "linear": linear, "linear_per_newton": round(linear / max(newton, 1), 1),
+                 "setup_s": round(t.get("preconditioner_setup", 0), 2),
+                 "krylov_s": round(t["linear_solve"] - t.get("preconditioner_setup", 0), 2),
+                 "total_s": round(t["total"], 2),
+                 "force_y": s["steps"][-1]["capstans"]["capstan"]["force"][1] if s["steps"] else float("nan"),
+                 "converged": s["converged"]})
+
 os.makedirs(args.out, exist_ok=True)
+with open(os.path.join(args.out, "preconditioners.csv"), "w", newline="") as fh:
+    w = csv.DictWriter(fh, fieldnames=list(rows[0].keys()))
+    w.writeheader()
+    w.writerows(rows)
+lines = []
+for group, title in (("preconditioner", "GMRES with each preconditioner"),
+                     ("eps1", "The pressure penalty eps1 (1x mesh, GMRES + MueLu)"),
+                     ("savers", "Without the cost savers (GMRES + MueLu)")):
+    sel = [r for r in rows if r["group"] == group]
+    if not sel:
+        continue
+    lines += [f"### {title}", "",
+              "| run | dofs | Newton its | linear its | linear its / Newton | prec. set-up s | Krylov s | total s | capstan force y |",
+              "|---|---|---|---|---|---|---|---|---|"]
+    for r in sel:
+        lines.append(f"| {r['run']} | {r['dofs']} | {r['newton']} | {r['linear']} | {r['linear_per_newton']} | "
+                     f"{r['setup_s']} | {r['krylov_s']} | {r['total_s']} | {r['force_y']:.10f}"
+                     f"{'' if r['converged'] else ' (did not converge)'} |")
+    lines.append("")
+text = "\n".join(lines)
 with open(os.path.join(args.out, "preconditioners.md"), "w") as fh:
-    fh.write(text + "\n")
+    fh.write(text)
 print(text)
