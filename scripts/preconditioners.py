@@ -74,8 +74,9 @@ runs = []  # (group, label, tag, solver, stratimikos, sets)
 for f in factors:
     cells = f"Mesh/Cells={{{14 * f},{4 * f},{6 * f}}}"
     for name, (solver, strat) in PRECONDITIONERS.items():
-        # Point relaxations need hundreds of iterations per Newton step already on 1x.
-        if f > 2 and name in ("Jacobi", "ILU(0)"):
+        # ILU(0) and Jacobi need 177 and 67 iterations per Newton step already
+        # on 1x (4-10x MueLu's time): not run on the finer meshes.
+        if f > 1 and name in ("Jacobi", "ILU(0)"):
             continue
         runs.append(("preconditioner", f"{f}x {name}", f"g1-{f}x-" + re.sub(r"[^A-Za-z0-9]+", "", name),
                      dict(solver, **{"Linear Solver": "GMRES"}), strat, [cells]))

@@ -247,6 +247,7 @@ class Run {
   Mesh mesh_;
   std::unique_ptr<Assembly> assembly_;
   std::unique_ptr<NewtonSolver> newton_;
+  RCP<FEMatrix> predictorMatrix_;
   RCP<Vector> u_;
   std::unique_ptr<FieldWriter> writer_;
   std::vector<StepRecord> steps_;
@@ -275,7 +276,8 @@ void Run::predict(double t0, double t1, double bareResidual, StepRecord& rec) {
   const auto map = u_->getMap();
   Vector z(map), Kz(map), f(map), rhs(map), du(map);
   assembly_->constraintIncrement(z, t0, t1);
-  auto W = assembly_->createMatrix();
+  if (predictorMatrix_.is_null()) predictorMatrix_ = assembly_->createMatrix();  // one for the run
+  const RCP<FEMatrix>& W = predictorMatrix_;
   // Effects linearise for the predictor: the bare state penetrates the
   // capstans by the whole increment (contact leaves out its geometric
   // stiffness, t_n / d, large there) and slides over them by the capstan's
