@@ -427,7 +427,7 @@ NewtonSolver::NewtonSolver(Assembly& assembly, const Teuchos::ParameterList& sol
 
 NewtonSolver::~NewtonSolver() = default;
 
-int NewtonSolver::linearSolve(const RCP<FEMatrix>& W, const Vector& b, Vector& x) {
+int NewtonSolver::linearSolve(const RCP<FEMatrix>& W, const Vector& b, Vector& x, double tolerance) {
   Kokkos::Timer timer;
   RCP<const Tpetra::Operator<>> op = W;
   auto space = impl_->model->get_x_space();
@@ -436,7 +436,10 @@ int NewtonSolver::linearSolve(const RCP<FEMatrix>& W, const Vector& b, Vector& x
   auto xt = Thyra::createVector(Teuchos::rcpFromRef(x), space);
   int iterations = -1;
   try {
-    const auto status = Thyra::solve<double>(*lows, Thyra::NOTRANS, *bt, xt.ptr());
+    Thyra::SolveCriteria<double> criteria;
+    criteria.solveMeasureType = Thyra::SolveMeasureType(Thyra::SOLVE_MEASURE_NORM_RESIDUAL, Thyra::SOLVE_MEASURE_NORM_RHS);
+    criteria.requestedTol = tolerance;
+    const auto status = Thyra::solve<double>(*lows, Thyra::NOTRANS, *bt, xt.ptr(), Teuchos::constPtr(criteria));
     if (status.solveStatus == Thyra::SOLVE_STATUS_CONVERGED || status.solveStatus == Thyra::SOLVE_STATUS_UNKNOWN)
       iterations = status.extraParameters.is_null() ? 0 : status.extraParameters->get("Iteration Count", 0);
   } catch (const std::exception&) {

@@ -31,8 +31,9 @@ class NewtonSolver {
   // |R| <= tolerance.
   NewtonResult solve(Vector& u, double tolerance);
   // One linear solve W x = b with the configured solver (x: initial guess in,
-  // solution out). Returns the Krylov iterations, or -1 if it failed.
-  int linearSolve(const RCP<FEMatrix>& W, const Vector& b, Vector& x);
+  // solution out) to the relative residual `tolerance` (Krylov solvers).
+  // Returns the Krylov iterations, or -1 if it failed.
+  int linearSolve(const RCP<FEMatrix>& W, const Vector& b, Vector& x, double tolerance);
   // Newton's next linear solve builds a new preconditioner (with Solver/
   // Preconditioner Reuse = Adaptive it is otherwise kept while it works).
   void rebuildPreconditioner();
