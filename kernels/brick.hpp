@@ -48,7 +48,42 @@ KOKKOS_INLINE_FUNCTION double brickVolume(const double X[8][3], const double x[8
   return v;
 }
 
-// Residual R[24] (dof 3a+i) and, if K is not null, the tangent K[24*24]
+// The tangent from the Gauss-point vectors of brickKernel (see there):
+//   K[ai][bk] = sum_gp H_ai d_bk + T[ak][bi] + delta_ik S_ab + g_ai g_bk/(eps V).
+KOKKOS_INLINE_FUNCTION void brickTangent(const double dq[8][24], const double Hq[8][24], const double eq[8][24],
+                                         const double S[8][8], const double g[24], double eps, double V,
+                                         double* K) {
+  // T first (its rows are read transposed within node-pair blocks), then K,
+  // three rows (one node's components) at a time so that each load of d
+  // feeds three multiply-adds; p(x) enters R_u as -p g: g g^T / (eps V).
+  double T[24][24];
+  for (int a = 0; a < 8; ++a) {
+    double acc[3][24] = {};
+    for (int gp = 0; gp < 8; ++gp)
+      for (int t = 0; t < 24; ++t)
+        for (int i = 0; i < 3; ++i) acc[i][t] += eq[gp][3 * a + i] * dq[gp][t];
+    for (int i = 0; i < 3; ++i)
+      for (int t = 0; t < 24; ++t) T[3 * a + i][t] = acc[i][t];
+  }
+  const double s = 1.0 / (eps * V);
+  for (int a = 0; a < 8; ++a) {
+    double row[3][24];
+    for (int i = 0; i < 3; ++i)
+      for (int t = 0; t < 24; ++t) row[i][t] = s * g[3 * a + i] * g[t];
+    for (int gp = 0; gp < 8; ++gp)
+      for (int t = 0; t < 24; ++t)
+        for (int i = 0; i < 3; ++i) row[i][t] += Hq[gp][3 * a + i] * dq[gp][t];
+    for (int i = 0; i < 3; ++i) {
+      for (int b = 0; b < 8; ++b) {
+        for (int k = 0; k < 3; ++k) row[i][3 * b + k] += T[3 * a + k][3 * b + i];
+        row[i][3 * b + i] += b >= a ? S[a][b] : S[b][a];
+      }
+      for (int t = 0; t < 24; ++t) K[(3 * a + i) * 24 + t] = row[i][t];
+    }
+  }
+}
+
+// The brick kernel: residual R[24] (dof 3a+i) and tangent K[24*24]
 // (row-major) of one brick. V: reference volume.
 //
 // Two passes over the 8 Gauss points: the first computes F and the volume v
@@ -62,10 +97,13 @@ KOKKOS_INLINE_FUNCTION double brickVolume(const double X[8][3], const double x[8
 //   T[ak][bi] = sum_gp e_ak d_bi,   S_ab = sum_gp wJ 2c D_a.D_b.
 // (Accumulating the 3x3 node-pair blocks per Gauss point instead, with
 // 3-wide inner loops, measured 1.18x slower.)
-KOKKOS_INLINE_FUNCTION void brickResidualTangent(const double X[8][3], const double x[8][3],
-                                                 double V, double pbar, double c, double eps,
-                                                 double* R, double* K, BrickState& out) {
-  const bool wantTangent = K != nullptr;
+//
+// The body, compiled once with and once without the tangent so that the
+// residual-only evaluations (line searches, constraint checks) carry none of
+// the tangent's stores or branches.
+template <bool wantTangent>
+KOKKOS_INLINE_FUNCTION void brickKernel(const double X[8][3], const double x[8][3], double V, double pbar,
+                                        double c, double eps, double* R, double* K, BrickState& out) {
   double Dq[8][8][3], Fq[8][3][3], wq[8];
   double v = 0, minJ = 1e300;
   for (int gp = 0; gp < 8; ++gp) {
@@ -82,56 +120,46 @@ KOKKOS_INLINE_FUNCTION void brickResidualTangent(const double X[8][3], const dou
   const double q = p + 2 * c;  // sigma = -q I + 2c B
   double g[24];
   for (int r = 0; r < 24; ++r) R[r] = g[r] = 0;
-  double dq[8][24], Hq[8][24], eq[8][24], S[8][8];
-  for (int a = 0; a < 8; ++a)
-    for (int b = 0; b < 8; ++b) S[a][b] = 0;
+  double dq[wantTangent ? 8 : 1][24], Hq[wantTangent ? 8 : 1][24], eq[wantTangent ? 8 : 1][24], S[8][8];
+  if (wantTangent)
+    for (int a = 0; a < 8; ++a)
+      for (int b = 0; b < 8; ++b) S[a][b] = 0;
   for (int gp = 0; gp < 8; ++gp) {
     const double(*D)[3] = Dq[gp];
     const double(*F)[3] = Fq[gp];
     double Finv[3][3];
     const double wJ = wq[gp] * inverse3(Fq[gp], Finv);
     const double c2 = 2 * c * wJ, qw = q * wJ;
-    double* d = dq[gp];
+    const int slot = wantTangent ? gp : 0;
     for (int a = 0; a < 8; ++a)
       for (int i = 0; i < 3; ++i) {
         // spatial gradient F^{-T} D_a and push-forward F D_a
         const double da = Finv[0][i] * D[a][0] + Finv[1][i] * D[a][1] + Finv[2][i] * D[a][2];
         const double Ga = F[i][0] * D[a][0] + F[i][1] * D[a][1] + F[i][2] * D[a][2];
-        d[3 * a + i] = da;
         R[3 * a + i] += wJ * (2 * c * Ga - q * da);
         g[3 * a + i] += wJ * da;
         if (!wantTangent) continue;
         // dP/dF contracted with D_a, D_b (P = 2cJ F - qJ F^{-T}, q at fixed p):
         //   wJ [2c (G_a,i d_b,k + delta_ik D_a.D_b) - q (d_a,i d_b,k - d_a,k d_b,i)]
-        Hq[gp][3 * a + i] = c2 * Ga - qw * da;
-        eq[gp][3 * a + i] = qw * da;
+        dq[slot][3 * a + i] = da;
+        Hq[slot][3 * a + i] = c2 * Ga - qw * da;
+        eq[slot][3 * a + i] = qw * da;
       }
     if (!wantTangent) continue;
     for (int a = 0; a < 8; ++a)
       for (int b = a; b < 8; ++b) S[a][b] += c2 * (D[a][0] * D[b][0] + D[a][1] * D[b][1] + D[a][2] * D[b][2]);
   }
-  if (!wantTangent) return;
-  // T first (its rows are read transposed within node-pair blocks), then each
-  // row of K in one sweep; p(x) enters R_u as -p g: condensed g g^T / (eps V).
-  double T[24][24];
-  for (int r = 0; r < 24; ++r) {
-    for (int t = 0; t < 24; ++t) T[r][t] = 0;
-    for (int gp = 0; gp < 8; ++gp)
-      for (int t = 0; t < 24; ++t) T[r][t] += eq[gp][r] * dq[gp][t];
-  }
-  const double s = 1.0 / (eps * V);
-  for (int r = 0; r < 24; ++r) {
-    const int a = r / 3, i = r % 3;
-    double row[24];
-    for (int t = 0; t < 24; ++t) row[t] = s * g[r] * g[t];
-    for (int gp = 0; gp < 8; ++gp)
-      for (int t = 0; t < 24; ++t) row[t] += Hq[gp][r] * dq[gp][t];
-    for (int b = 0; b < 8; ++b) {
-      for (int k = 0; k < 3; ++k) row[3 * b + k] += T[3 * a + k][3 * b + i];
-      row[3 * b + i] += b >= a ? S[a][b] : S[b][a];
-    }
-    for (int t = 0; t < 24; ++t) K[r * 24 + t] = row[t];
-  }
+  if constexpr (wantTangent) brickTangent(dq, Hq, eq, S, g, eps, V, K);
+}
+
+// Residual R[24] and, if K is not null, the tangent K[24*24] of one brick.
+KOKKOS_INLINE_FUNCTION void brickResidualTangent(const double X[8][3], const double x[8][3],
+                                                 double V, double pbar, double c, double eps,
+                                                 double* R, double* K, BrickState& out) {
+  if (K)
+    brickKernel<true>(X, x, V, pbar, c, eps, R, K, out);
+  else
+    brickKernel<false>(X, x, V, pbar, c, eps, R, nullptr, out);
 }
 
 
