@@ -76,13 +76,29 @@ for st in free["steps"]:
 two = run(slice_scene, "free-2ranks", ranks=2,
           sets=["Solver/Linear Solver=GMRES", "Solver/Preconditioner=ILU", "Solver/Linear Tolerance=1e-12",
                 "Solver/Linear Tolerance Method=Fixed"])
+# Where both runs cut a step into the same sub-steps they agree to solver
+# tolerance (1e-8). A cut is a discrete decision (Newton failed within its
+# limit), and round-off can tip it one way on one rank count and the other
+# way on the other. Different sub-steps give a different friction history:
+# converged both, and apart by ~1e-6 (seen: 3 cuts against 2 in step 7,
+# rotation apart by 5e-7), and the steps after it inherit that history. From
+# the first step cut differently on, the runs must agree to 1e-5; before it to
+# 1e-8, and most steps must come before it, so that the tight check cannot
+# pass vacuously.
+same_path = 0
+diverged = False
 for a, b in zip(free["steps"], two["steps"]):
     ca, cb = a["supports"]["core"], b["supports"]["core"]
-    T.check(abs(ca["rotation"] - cb["rotation"]) < 1e-8 * abs(ca["rotation"]) and
-            rel_diff(ca["speed_ratio"], cb["speed_ratio"]) < 1e-8 and
-            max(abs(x - y) for x, y in zip(a["capstans"]["capstan"]["force"], b["capstans"]["capstan"]["force"])) < 1e-8 * F,
-            f"step {a['step']}: 1 and 2 ranks agree (rotation {ca['rotation']:.12g} / {cb['rotation']:.12g}, "
-            f"speed ratio {ca['speed_ratio']:.12g} / {cb['speed_ratio']:.12g})")
+    diverged = diverged or a["cutbacks"] != b["cutbacks"]
+    tol = 1e-5 if diverged else 1e-8
+    same_path += not diverged
+    T.check(abs(ca["rotation"] - cb["rotation"]) < tol * abs(ca["rotation"]) and
+            rel_diff(ca["speed_ratio"], cb["speed_ratio"]) < tol and
+            max(abs(x - y) for x, y in zip(a["capstans"]["capstan"]["force"], b["capstans"]["capstan"]["force"])) < tol * F,
+            f"step {a['step']}: 1 and 2 ranks agree to {tol:g} (cuts {a['cutbacks']} / {b['cutbacks']}; rotation "
+            f"{ca['rotation']:.12g} / {cb['rotation']:.12g}, speed ratio {ca['speed_ratio']:.12g} / {cb['speed_ratio']:.12g})")
+T.check(same_path >= len(free["steps"]) // 2,
+        f"{same_path} of {len(free['steps'])} steps before the first one cut differently on 1 and 2 ranks")
 
 # Braked roller: torque balance through the nip, speed ratio falls with the brake.
 for M in (0.15, 0.3):
