@@ -159,10 +159,10 @@ ParameterList validParameters() {
           "aggregation with the rigid-body modes). Auto: MueLu from 1000 dofs, ILU below");
   sol.set("ILU Level", 1, "ILU: level of fill (>= 0)");
   sol.set("Preconditioner Reuse", std::string("Adaptive"),
-          "Adaptive | None. Adaptive: Newton keeps its preconditioner across iterations, load "
-          "steps and pressure passes, and rebuilds it when a Krylov solve needs more than twice "
-          "the iterations (+10) of the first solve after the last build, or hits its limit; "
-          "None: a new one every Newton iteration");
+          "Adaptive | None. Adaptive: Newton builds its preconditioner at each load step's start "
+          "and keeps it across iterations and pressure passes, rebuilding it when a Krylov solve "
+          "needs more than twice the iterations (+10) of the first solve after the last build, or "
+          "hits its limit; None: a new one every Newton iteration");
   sol.set("Linear Tolerance", 1e-10, "Relative residual of each linear solve (0 < tol < 1)");
   sol.set("Linear Tolerance Method", std::string("Adaptive"),
           "Adaptive | Fixed. Adaptive: Eisenstat-Walker forcing terms (each Krylov solve only as "

@@ -1377,8 +1377,8 @@ int Run::execute() {
     }
     if (!ok) break;
     {
-      Vector f(u_->getMap());
       assembly_->applyConstraints(*u_, tDone);  // rigid cores' face nodes where the cores are
+      Vector f(u_->getMap());
       assembly_->evaluate(*u_, &f, nullptr);  // reactions at the converged state
     }
     recordStep(rec);
