@@ -101,6 +101,23 @@ KOKKOS_INLINE_FUNCTION void brickTangent(const double dq[8][24], const double Hq
 // The body, compiled once with and once without the tangent so that the
 // residual-only evaluations (line searches, constraint checks) carry none of
 // the tangent's stores or branches.
+// g = d v / d x (24, dof 3a+i) = int J F^{-T} D_a dV: how the element's
+// current volume changes with its nodes' positions. The residual's pressure
+// part is -p g; the saddle-point pressure step (src/pressure_step.hpp) uses g
+// as the element's row of the linearised volume constraint.
+KOKKOS_INLINE_FUNCTION void brickVolumeGradient(const double X[8][3], const double x[8][3], double g[24]) {
+  for (int r = 0; r < 24; ++r) g[r] = 0;
+  for (int gp = 0; gp < 8; ++gp) {
+    double D[8][3], F[3][3], Finv[3][3];
+    const double w = hexReferenceGradients(X, gauss2(gp & 1), gauss2((gp >> 1) & 1), gauss2(gp >> 2), D);
+    deformationGradient(x, D, F);
+    const double wJ = w * inverse3(F, Finv);
+    for (int a = 0; a < 8; ++a)
+      for (int i = 0; i < 3; ++i)
+        g[3 * a + i] += wJ * (Finv[0][i] * D[a][0] + Finv[1][i] * D[a][1] + Finv[2][i] * D[a][2]);
+  }
+}
+
 template <bool wantTangent>
 KOKKOS_INLINE_FUNCTION void brickKernel(const double X[8][3], const double x[8][3], double V, double pbar,
                                         double c, double eps, double* R, double* K, BrickState& out) {

@@ -345,6 +345,18 @@ void Assembly::findEntryOffsets() {
 
 RCP<FEMatrix> Assembly::createMatrix() const { return rcp(new FEMatrix(graph_)); }
 
+std::vector<GO> Assembly::freeDofGlobalIds(const Effect& e) const {
+  auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), e.local().dofs);
+  std::vector<GO> out(dofs.size());
+  for (size_t k = 0; k < dofs.extent(0); ++k)
+    for (size_t j = 0; j < dofs.extent(1); ++j) {
+      const int d = dofs(k, j);
+      out[k * dofs.extent(1) + j] =
+          constraints_.supportOf[d] >= 0 ? GO(-1) : overlapDofMap_->getGlobalElement(overlapLid(d));
+    }
+  return out;
+}
+
 LO Assembly::overlapLid(int dof) const {
   const int ownedNodeDofs = int(3 * mesh_.numOwnedNodes);
   if (dof >= nodeDofs_) return LO(coresOwned_ ? ownedNodeDofs + (dof - nodeDofs_) : dof);

@@ -115,6 +115,10 @@ class Assembly {
   // z = prescribed displacement increment from t0 to t1 (zero on free dofs).
   void constraintIncrement(Vector& z, double t0, double t1) const;
 
+  // Global dof ids (in dofMap()) of each entity's dofs of effect e, row-major
+  // as e.local().dofs; -1 for held dofs (supports, a rigid core's face nodes).
+  std::vector<GO> freeDofGlobalIds(const Effect& e) const;
+
   // Reaction force of each constrained support on the body, from the last
   // evaluation (global sum).
   std::vector<std::array<double, 3>> constraintReactions() const;

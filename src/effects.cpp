@@ -110,6 +110,23 @@ void BrickEffect::launch(const NodalVectors& x, const NodalVectors&, bool tangen
       });
 }
 
+void BrickEffect::volumeGradients(const NodalVectors& x, Matrix& g) const {
+  auto nodes = nodes_;
+  auto X = X_;
+  if (g.extent(0) != nodes.extent(0)) g = Matrix("brick dv/dx", nodes.extent(0), 24);
+  auto out = g;
+  Kokkos::parallel_for(
+      "brick volume gradient", Kokkos::RangePolicy<ExecSpace>(0, nodes.extent(0)), KOKKOS_LAMBDA(int e) {
+        double Xe[8][3], xe[8][3];
+        for (int a = 0; a < 8; ++a)
+          for (int i = 0; i < 3; ++i) {
+            Xe[a][i] = X(e, a, i);
+            xe[a][i] = x(nodes(e, a), i);
+          }
+        kernels::brickVolumeGradient(Xe, xe, &out(e, 0));
+      });
+}
+
 void BrickEffect::multiplierMap(const Kokkos::View<double*>& next) const {
   Kokkos::deep_copy(next, pressure);
 }

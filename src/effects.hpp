@@ -99,6 +99,11 @@ class BrickEffect : public Effect {
   // Element Cauchy stress (xx yy zz xy yz xz) and von Mises at the centroids.
   void centroidStress(const NodalVectors& x, Matrix& stress, Kokkos::View<double*>& mises) const;
   double c() const { return c_; }
+  // The penalty eps of the Newton solves (the scene's eps1, raised to
+  // Solver/Minimum Solve Penalty).
+  double solvePenalty() const { return penalty_; }
+  // d v_e / d x at positions x (overlapped nodes), 24 per element (dof 3a+i).
+  void volumeGradients(const NodalVectors& x, Matrix& g) const;
 
   // Pressure anchors: G(pbar) = p(x); violation max |v/V - 1|.
   Kokkos::View<double*> multipliers() override { return pressureAnchor; }

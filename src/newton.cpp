@@ -10,6 +10,7 @@
 #include <Stratimikos_MueLuHelpers.hpp>
 #include <Teuchos_AbstractFactoryStd.hpp>
 #include <Teuchos_oblackholestream.hpp>
+#include <Thyra_DefaultLinearOpSource.hpp>
 #include <Thyra_Ifpack2PreconditionerFactory.hpp>
 #include <Thyra_LinearOpWithSolveFactoryHelpers.hpp>
 #include <Thyra_StateFuncModelEvaluatorBase.hpp>
@@ -447,6 +448,49 @@ int NewtonSolver::linearSolve(const RCP<FEMatrix>& W, const Vector& b, Vector& x
   }
   impl_->linearSeconds += timer.seconds();
   return iterations;
+}
+
+RCP<FEMatrix> NewtonSolver::matrix() const {
+  return Teuchos::rcp_dynamic_cast<FEMatrix>(ConverterT::getTpetraOperator(impl_->W), true);
+}
+
+std::function<void(const Vector&, Vector&)> NewtonSolver::approximateInverse() {
+  auto space = impl_->model->get_x_space();
+  double* seconds = &impl_->linearSeconds;
+  auto wrap = [space](const Vector& r, Vector& z) {
+    // As multivectors: MueLu's Thyra operator takes nothing else.
+    using MV = Tpetra::MultiVector<>;
+    return std::make_pair(Thyra::createConstMultiVector(Teuchos::rcpFromRef<const MV>(r), space),
+                          Thyra::createMultiVector(Teuchos::rcpFromRef<MV>(z), space));
+  };
+  if (!impl_->newtonPrecFactory.is_null()) {
+    Kokkos::Timer timer;
+    // Lagged (Preconditioner Reuse = Adaptive): keeps the one Newton built.
+    impl_->newtonPrecFactory->initializePrec(Thyra::defaultLinearOpSource<double>(impl_->W), impl_->prec.get(),
+                                             Thyra::SUPPORT_SOLVE_UNSPECIFIED);
+    *seconds += timer.seconds();
+    RCP<const Thyra::LinearOpBase<double>> op = impl_->prec->getUnspecifiedPrecOp();
+    if (op.is_null()) op = impl_->prec->getRightPrecOp();
+    if (op.is_null()) op = impl_->prec->getLeftPrecOp();
+    if (!op.is_null())
+      return [op, wrap, seconds](const Vector& r, Vector& z) {
+        Kokkos::Timer t;
+        auto [rt, zt] = wrap(r, z);
+        Thyra::apply(*op, Thyra::NOTRANS, *rt, zt.ptr());
+        *seconds += t.seconds();
+      };
+  }
+  Kokkos::Timer timer;
+  RCP<const Thyra::LinearOpBase<double>> W = impl_->W;
+  auto lows = Thyra::linearOpWithSolve(*impl_->lows, W);
+  *seconds += timer.seconds();
+  return [lows, wrap, seconds](const Vector& r, Vector& z) {
+    Kokkos::Timer t;
+    auto [rt, zt] = wrap(r, z);
+    z.putScalar(0.0);
+    Thyra::solve<double>(*lows, Thyra::NOTRANS, *rt, zt.ptr());
+    *seconds += t.seconds();
+  };
 }
 
 void NewtonSolver::rebuildPreconditioner() {

@@ -5,6 +5,7 @@
 
 #include <Teuchos_ParameterList.hpp>
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -37,6 +38,13 @@ class NewtonSolver {
   // Newton's next linear solve builds a new preconditioner (with Solver/
   // Preconditioner Reuse = Adaptive it is otherwise kept while it works).
   void rebuildPreconditioner();
+  // Newton's matrix (values: whatever was last assembled into it).
+  RCP<FEMatrix> matrix() const;
+  // z = K~^-1 r, an approximate inverse of matrix() as its values are now:
+  // Newton's preconditioner (built if it has none yet), or, for a direct
+  // solver, a factorisation made once here. Its application time counts as
+  // linear solve time.
+  std::function<void(const Vector& r, Vector& z)> approximateInverse();
   double linearSolveSeconds() const;
   // The part of linearSolveSeconds() spent setting up preconditioners.
   double preconditionerSeconds() const;

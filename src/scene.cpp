@@ -178,6 +178,10 @@ ParameterList validParameters() {
   sol.set("Line Search", std::string("Backtrack"), "Backtrack | Polynomial | Full Step (NOX line search)");
   sol.set("Volume Tolerance", 1e-10, "Pressure loop ends when max |v_e/V_e - 1| is below this");
   sol.set("Max Pressure Iterations", 100, "Most pressure-anchor updates per step");
+  sol.set("Pressure Update", std::string("Saddle Point"),
+          "How the pressure loop moves the element pressure anchors after each Newton solve: "
+          "Saddle Point (positions and anchors from one block Krylov solve, v_e = V_e to first order) "
+          "or Anderson (pbar <- p(x), Anderson-accelerated)");
   sol.set("Pressure Acceleration Depth", 5,
           "Anderson acceleration depth of the pressure loop (0 = plain pbar <- p(x))");
   sol.set("Minimum Solve Penalty", 1e-2,
@@ -970,6 +974,7 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
   oneOf("Predictor", {"Tangent", "Previous"});
   oneOf("Linear Tolerance Method", {"Adaptive", "Fixed"});
   oneOf("Preconditioner Reuse", {"Adaptive", "None"});
+  oneOf("Pressure Update", {"Saddle Point", "Anderson"});
   for (const char* n : {"Linear Tolerance", "Newton Relative Tolerance", "Volume Tolerance"}) {
     const double x = sol.get<double>(n);
     if (!(x > 0 && x < 1)) v.fail(std::string("Solver/") + n, "must be in (0, 1)");

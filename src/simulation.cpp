@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "anderson.hpp"
+#include "pressure_step.hpp"
 #include "assembly.hpp"
 #include "checkpoint.hpp"
 #include "errors.hpp"
@@ -28,6 +29,10 @@ namespace fs = std::filesystem;
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// The saddle-point pressure step's GMRES tolerance (relative): the volume
+// error then falls about 1000x per pass in the linear regime.
+constexpr double kPressureStepTolerance = 1e-3;
 double since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
@@ -174,6 +179,10 @@ class Run {
   // central difference of the residual along a random direction, printed.
   void checkTangent();
   bool solveAt(double t0, double t1, StepRecord& rec, std::string& failure);
+  // The pressure loop's saddle-point step at the converged state (src/
+  // pressure_step.hpp): moves u and the pressure anchors together. False if
+  // the block solve made no progress (nothing is changed then).
+  bool saddlePointPressureStep(double t, double volumeChange, Vector& f, StepRecord& rec);
   void recordStep(StepRecord& rec);
   CapstanRecord capstanFigures(const ContactEffect& contact, const FrictionEffect* friction) const;
   // Every effect's augmentation multipliers (pressure anchors, contact
@@ -247,6 +256,7 @@ class Run {
   Mesh mesh_;
   std::unique_ptr<Assembly> assembly_;
   std::unique_ptr<NewtonSolver> newton_;
+  std::unique_ptr<PressureStep> pressureStep_;  // null with Solver/Pressure Update = Anderson
   RCP<FEMatrix> predictorMatrix_;
   RCP<Vector> u_;
   std::unique_ptr<FieldWriter> writer_;
@@ -457,16 +467,16 @@ bool Run::solveAt(double t0, double t, StepRecord& rec, std::string& failure) {
     }
     // Refresh p(x), v, contact pressures at the converged state.
     assembly_->evaluate(*u_, &f, nullptr);
-    bool met = true;
+    bool met = true, volumeMet = true;
     std::vector<const Effect*> settled;  // plain-updated effects already within tolerance
     for (const auto& e : assembly_->effects()) {
       double v = 0;
       Teuchos::reduceAll(*comm_, Teuchos::REDUCE_MAX, e->constraintViolation(), Teuchos::outArg(v));
-      if (e.get() == &assembly_->bricks()) rec.volumeChange = v;
+      if (e.get() == &assembly_->bricks()) rec.volumeChange = v, volumeMet = v <= e->constraintTolerance();
       if (!opt_.quiet && rank0_ && std::getenv("CAPSTAN_NEWTON_LOG"))
         std::printf("    %s: %.3e (tolerance %.1e)\n", e->constraintName().c_str(), v, e->constraintTolerance());
       if (v <= e->constraintTolerance()) {
-        if (rolling_) settled.push_back(e.get());
+        if (rolling_ || pressureStep_) settled.push_back(e.get());
         continue;
       }
       met = false;
@@ -479,6 +489,18 @@ bool Run::solveAt(double t0, double t, StepRecord& rec, std::string& failure) {
       }
     }
     if (met) return true;
+    if (pressureStep_) {
+      // The other multipliers first: the pressure step then re-balances the
+      // body under their new values too, so their change does not spoil the
+      // volumes it makes exact. Those within their tolerance stay put (a
+      // settled contact's round-off moves would otherwise set the volume
+      // error each pass leaves, and cost the step its hardest iterations).
+      const std::vector<double> pressureNext = multiplierMap(true);  // at the converged state
+      setMultipliers(multiplierMap(false), false, settled);
+      if (!volumeMet && !saddlePointPressureStep(t, rec.volumeChange, f, rec))  // no progress: a plain pass instead
+        setMultipliers(pressureNext, true);
+      continue;
+    }
     setMultipliers(mixing.next(multipliers(true), multiplierMap(true)), true);
     // Rolling: contact and friction multipliers within their tolerance stay
     // put. Moving them anyway (points flicker at the tolerance level as they
@@ -490,6 +512,32 @@ bool Run::solveAt(double t0, double t, StepRecord& rec, std::string& failure) {
   failure = "augmentation loop did not meet the volume and contact tolerances in " +
             std::to_string(maxOuter) + " iterations";
   return false;
+}
+
+bool Run::saddlePointPressureStep(double t, double volumeChange, Vector& f, StepRecord& rec) {
+  BrickEffect& bricks = assembly_->bricks();
+  auto W = newton_->matrix();
+  assembly_->evaluate(*u_, &f, W.get());  // the tangent at the converged state
+  Vector dx(assembly_->dofMap());
+  Kokkos::View<double*> dp("pressure step dp", bricks.pressureAnchor.extent(0));
+  // Solved only as far as the volume tolerance needs (with a margin of 10),
+  // and at least to kPressureStepTolerance: the last passes of a step have
+  // only the hardest (nearly spurious) pressure modes left.
+  const double need = 0.1 * bricks.constraintTolerance() / volumeChange;
+  const double tolerance = std::min(0.1, std::max(kPressureStepTolerance, need));
+  const auto step = pressureStep_->solve(*W, newton_->approximateInverse(), f, tolerance,
+                                         scene_.solver.get<int>("Max Linear Iterations"), dx, dp);
+  rec.linear += step.iterations;
+  if (!opt_.quiet && rank0_ && std::getenv("CAPSTAN_NEWTON_LOG"))
+    std::printf("    pressure step: %d GMRES iterations, residual reduced %.2e\n", step.iterations, step.reduction);
+  if (!(step.reduction < 1)) return false;
+  u_->update(1.0, dx, 1.0);
+  assembly_->applyConstraints(*u_, t);
+  auto pbar = bricks.pressureAnchor;
+  Kokkos::parallel_for(
+      "pressure step anchors", Kokkos::RangePolicy<ExecSpace>(0, pbar.extent(0)),
+      KOKKOS_LAMBDA(int e) { pbar(e) += dp(e); });
+  return true;
 }
 
 std::vector<double> Run::multipliers(bool accelerated) const {
@@ -1251,6 +1299,8 @@ int Run::execute() {
   } catch (const InputError& e) {  // the Solver/NOX or Solver/Stratimikos sublist
     throw InputError(scene_.file + ": " + e.what());
   }
+  if (scene_.solver.get<std::string>("Pressure Update") == "Saddle Point")
+    pressureStep_ = std::make_unique<PressureStep>(*assembly_);
   u_ = rcp(new Vector(assembly_->dofMap()));
   for (const auto& core : assembly_->rigidCores()) rolling_ = rolling_ || core.free[3];
   double size2 = 0;

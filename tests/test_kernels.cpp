@@ -106,6 +106,10 @@ TEST(Brick, VolumeGradientIsG) {
     brickResidualTangent(X, x, V, 0.0, 1.0, 1e300, R0.data(), nullptr, st);
     brickResidualTangent(X, x, V, 1.0, 1.0, 1e300, R1.data(), nullptr, st);
     EXPECT_NEAR(R0[col] - R1[col], dv, 1e-8 * std::fabs(dv) + 1e-12);
+    // and brickVolumeGradient gives the same g.
+    double g[24];
+    brickVolumeGradient(X, x, g);
+    EXPECT_NEAR(g[col], dv, 1e-8 * std::fabs(dv) + 1e-12);
   }
 }
 

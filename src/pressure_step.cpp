@@ -1,0 +1,181 @@
+#include "pressure_step.hpp"
+
+#include <Kokkos_Timer.hpp>
+
+#include <cmath>
+
+namespace capstan {
+
+PressureStep::PressureStep(Assembly& assembly) : assembly_(assembly) {
+  const BrickEffect& bricks = assembly_.bricks();
+  const size_t ne = bricks.pressureAnchor.extent(0);
+  auto comm = assembly_.dofMap()->getComm();
+  elementMap_ = rcp(new Map(Tpetra::global_size_t(Teuchos::OrdinalTraits<Tpetra::global_size_t>::invalid()), ne,
+                            GO(0), comm));
+  freeDofs_ = assembly_.freeDofGlobalIds(bricks);
+  weight_ = rcp(new Vector(elementMap_));
+  schurInverse_ = rcp(new Vector(elementMap_));
+  heldRow_ = rcp(new Vector(elementMap_));
+  // G^T's structure: each element's free dofs. Values come with each solve.
+  gradient_ = rcp(new CrsMatrix(elementMap_, 24));
+  std::vector<GO> cols;
+  std::vector<double> zeros(24, 0.0);
+  for (size_t e = 0; e < ne; ++e) {
+    cols.clear();
+    for (int k = 0; k < 24; ++k)
+      if (freeDofs_[24 * e + k] >= 0) cols.push_back(freeDofs_[24 * e + k]);
+    if (!cols.empty())
+      gradient_->insertGlobalValues(elementMap_->getGlobalElement(LO(e)), Teuchos::ArrayView<const GO>(cols),
+                                    Teuchos::ArrayView<const double>(zeros.data(), cols.size()));
+  }
+  gradient_->fillComplete(assembly_.dofMap(), elementMap_);
+  auto colMap = gradient_->getColMap();
+  columns_.resize(freeDofs_.size());
+  for (size_t i = 0; i < freeDofs_.size(); ++i)
+    columns_[i] = freeDofs_[i] >= 0 ? colMap->getLocalElement(freeDofs_[i]) : LO(-1);
+}
+
+PressureStep::Block PressureStep::newBlock() const {
+  return {rcp(new Vector(assembly_.dofMap())), rcp(new Vector(elementMap_))};
+}
+
+void PressureStep::fillVolumeGradient() {
+  const BrickEffect& bricks = assembly_.bricks();
+  bricks.volumeGradients(assembly_.positions(), g_);
+  auto g = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), g_);
+  auto V = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bricks.referenceVolume);
+  const double eps = bricks.solvePenalty();
+  auto w = weight_->getDataNonConst();
+  auto sInv = schurInverse_->getDataNonConst();
+  auto held = heldRow_->getDataNonConst();
+  gradient_->resumeFill();
+  std::vector<LO> cols;
+  std::vector<double> vals;
+  for (size_t e = 0; e < g.extent(0); ++e) {
+    cols.clear(), vals.clear();
+    double norm2 = 0;
+    for (int k = 0; k < 24; ++k) {
+      norm2 += g(e, k) * g(e, k);
+      if (columns_[24 * e + k] >= 0) cols.push_back(columns_[24 * e + k]), vals.push_back(g(e, k));
+    }
+    w[e] = std::sqrt(norm2) / (eps * V(e));
+    sInv[e] = 1 / (w[e] * eps * V(e));
+    held[e] = cols.empty() ? w[e] * eps * V(e) : 0.0;
+    if (!cols.empty())
+      gradient_->replaceLocalValues(LO(e), Teuchos::ArrayView<const LO>(cols), Teuchos::ArrayView<const double>(vals));
+  }
+  gradient_->fillComplete(assembly_.dofMap(), elementMap_);
+}
+
+void PressureStep::applySystem(const CrsMatrix& K, const Block& x, Block& y) const {
+  // y_u = K x_u - G x_p
+  K.apply(*x.u, *y.u);
+  gradient_->apply(*x.p, *y.u, Teuchos::TRANS, -1.0, 1.0);
+  // y_p = w .* (G^T x_u) (+ the identity-like rows of elements with no free dof)
+  gradient_->apply(*x.u, *y.p);
+  y.p->elementWiseMultiply(1.0, *weight_, *y.p, 0.0);
+  y.p->elementWiseMultiply(1.0, *heldRow_, *x.p, 1.0);
+}
+
+void PressureStep::applyPreconditioner(const Inverse& Kinv, const Block& r, Block& z) const {
+  // z_p = (w eps M)^-1 r_p, then z_u = K~^-1 (r_u + G z_p)
+  z.p->elementWiseMultiply(1.0, *schurInverse_, *r.p, 0.0);
+  Vector t(*r.u, Teuchos::Copy);
+  gradient_->apply(*z.p, t, Teuchos::TRANS, 1.0, 1.0);
+  Kinv(t, *z.u);
+}
+
+PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv, const Vector& f, double tolerance,
+                                         int maxIterations, Vector& dx, Kokkos::View<double*> dp) {
+  Kokkos::Timer timer;
+  fillVolumeGradient();
+  const BrickEffect& bricks = assembly_.bricks();
+  // Right-hand side: (-R, w .* (V - v)); rows of elements with no free dof: 0.
+  Block rhs = newBlock();
+  rhs.u->update(-1.0, f, 0.0);
+  {
+    auto v = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bricks.volume);
+    auto V = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bricks.referenceVolume);
+    auto r = rhs.p->getDataNonConst();
+    auto w = weight_->getData();
+    auto held = heldRow_->getData();
+    for (size_t e = 0; e < v.extent(0); ++e) r[e] = held[e] > 0 ? 0.0 : w[e] * (V(e) - v(e));
+  }
+  Block x = newBlock(), work = newBlock(), z = newBlock();
+  const double beta0 = std::sqrt(dot(rhs, rhs));
+  Result result;
+  const int m = std::max(1, std::min(maxIterations, 300));  // restart length
+  while (basis_.size() < size_t(m + 1)) basis_.push_back(newBlock());
+  double beta = beta0;
+  Block& r = work;
+  update(1.0, rhs, 0.0, r);
+  while (beta > tolerance * beta0 && result.iterations < maxIterations) {
+    // One GMRES(m) cycle from the residual r (Givens rotations on the
+    // Hessenberg matrix H, modified Gram-Schmidt).
+    std::vector<double> H((m + 1) * m, 0.0), cs(m), sn(m), s(m + 1, 0.0);
+    auto h = [&](int i, int j) -> double& { return H[i * m + j]; };
+    update(1 / beta, r, 0.0, basis_[0]);
+    s[0] = beta;
+    int k = 0;  // columns built
+    double res = beta;
+    while (k < m && result.iterations < maxIterations) {
+      applyPreconditioner(Kinv, basis_[k], z);
+      Block& w = basis_[k + 1];
+      applySystem(K, z, w);
+      for (int i = 0; i <= k; ++i) {
+        h(i, k) = dot(w, basis_[i]);
+        update(-h(i, k), basis_[i], 1.0, w);
+      }
+      h(k + 1, k) = std::sqrt(dot(w, w));
+      if (h(k + 1, k) > 0) update(0.0, w, 1 / h(k + 1, k), w);
+      for (int i = 0; i < k; ++i) {
+        const double a = h(i, k), b = h(i + 1, k);
+        h(i, k) = cs[i] * a + sn[i] * b;
+        h(i + 1, k) = -sn[i] * a + cs[i] * b;
+      }
+      const double a = h(k, k), b = h(k + 1, k), d = std::hypot(a, b);
+      cs[k] = d > 0 ? a / d : 1.0, sn[k] = d > 0 ? b / d : 0.0;
+      h(k, k) = d, h(k + 1, k) = 0;
+      s[k + 1] = -sn[k] * s[k];
+      s[k] = cs[k] * s[k];
+      res = std::fabs(s[k + 1]);
+      ++k, ++result.iterations;
+      if (res <= tolerance * beta0 || b == 0) break;
+    }
+    // x += P^-1 (basis y), y = H^-1 s (upper triangular after the rotations)
+    std::vector<double> y(k, 0.0);
+    for (int i = k - 1; i >= 0; --i) {
+      double t = s[i];
+      for (int j = i + 1; j < k; ++j) t -= h(i, j) * y[j];
+      y[i] = h(i, i) != 0 ? t / h(i, i) : 0.0;
+    }
+    r.u->putScalar(0.0), r.p->putScalar(0.0);
+    for (int i = 0; i < k; ++i) update(y[i], basis_[i], 1.0, r);
+    applyPreconditioner(Kinv, r, z);
+    update(1.0, z, 1.0, x);
+    // The true residual, for the next cycle and the figure reported.
+    applySystem(K, x, r);
+    update(1.0, rhs, -1.0, r);
+    const double trueRes = std::sqrt(dot(r, r));
+    const bool progress = trueRes < beta;
+    beta = trueRes;
+    if (!progress) break;  // stagnated: keep what there is (the loop checks the outcome)
+  }
+  result.reduction = beta0 > 0 ? beta / beta0 : 0.0;
+  // Held dofs stay where they are (K's identity rows would keep them at ~0
+  // anyway; the preconditioner need not).
+  dx.update(1.0, *x.u, 0.0);
+  {
+    auto d = dx.getDataNonConst();
+    for (LO i = 0; i < LO(dx.getLocalLength()); ++i)
+      if (assembly_.ownedConstrained(i)) d[i] = 0;
+  }
+  auto hp = Kokkos::create_mirror_view(dp);
+  auto xp = x.p->getData();
+  for (size_t e = 0; e < hp.extent(0); ++e) hp(e) = xp[e];
+  Kokkos::deep_copy(dp, hp);
+  seconds_ += timer.seconds();
+  return result;
+}
+
+}  // namespace capstan
