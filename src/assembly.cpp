@@ -345,16 +345,32 @@ void Assembly::findEntryOffsets() {
 
 RCP<FEMatrix> Assembly::createMatrix() const { return rcp(new FEMatrix(graph_)); }
 
-std::vector<GO> Assembly::freeDofGlobalIds(const Effect& e) const {
+void Assembly::chainRows(const Effect& e, const Matrix& values, std::vector<size_t>& rowStart,
+                         std::vector<GO>& cols, std::vector<double>& vals) const {
   auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), e.local().dofs);
-  std::vector<GO> out(dofs.size());
-  for (size_t k = 0; k < dofs.extent(0); ++k)
+  auto v = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), values);
+  const auto& supportOf = constraints_.supportOf;
+  auto gid = [&](int dof) { return overlapDofMap_->getGlobalElement(overlapLid(dof)); };
+  rowStart.assign(1, 0), cols.clear(), vals.clear();
+  for (size_t k = 0; k < dofs.extent(0); ++k) {
+    const size_t first = cols.size();
+    auto add = [&](GO col, double x) {
+      for (size_t i = first; i < cols.size(); ++i)
+        if (cols[i] == col) return void(vals[i] += x);
+      cols.push_back(col), vals.push_back(x);
+    };
     for (size_t j = 0; j < dofs.extent(1); ++j) {
-      const int d = dofs(k, j);
-      out[k * dofs.extent(1) + j] =
-          constraints_.supportOf[d] >= 0 ? GO(-1) : overlapDofMap_->getGlobalElement(overlapLid(d));
+      const int d = dofs(k, j), c = coreOfNode_[d / 3];
+      if (c < 0) {
+        if (supportOf[d] < 0) add(gid(d), v(k, j));
+        continue;
+      }
+      const RigidCore& core = cores_[c];
+      if (core.free[d % 3]) add(gid(core.firstDof + d % 3), v(k, j));
+      if (core.free[3]) add(gid(core.firstDof + 3), v(k, j) * followers_[d / 3].b[d % 3]);
     }
-  return out;
+    rowStart.push_back(cols.size());
+  }
 }
 
 LO Assembly::overlapLid(int dof) const {

@@ -115,9 +115,14 @@ class Assembly {
   // z = prescribed displacement increment from t0 to t1 (zero on free dofs).
   void constraintIncrement(Vector& z, double t0, double t1) const;
 
-  // Global dof ids (in dofMap()) of each entity's dofs of effect e, row-major
-  // as e.local().dofs; -1 for held dofs (supports, a rigid core's face nodes).
-  std::vector<GO> freeDofGlobalIds(const Effect& e) const;
+  // Per-entity vectors of effect e over its dofs (values: entities x dofs,
+  // e.g. each brick's d v_e / d x) as sparse rows over the free global dofs of
+  // dofMap(), with the chain rule the matrix assembly applies: a rigid core's
+  // face-node entries go to the core's free unknowns (the translations, and
+  // the rotation through du/dtheta at the last evaluation); held dofs drop.
+  // Row r is cols/vals[rowStart[r] .. rowStart[r + 1]), each column once.
+  void chainRows(const Effect& e, const Matrix& values, std::vector<size_t>& rowStart, std::vector<GO>& cols,
+                 std::vector<double>& vals) const;
 
   // Reaction force of each constrained support on the body, from the last
   // evaluation (global sum).

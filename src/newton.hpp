@@ -42,8 +42,9 @@ class NewtonSolver {
   RCP<FEMatrix> matrix() const;
   // z = K~^-1 r, an approximate inverse of matrix() as its values are now:
   // Newton's preconditioner (built if it has none yet), or, for a direct
-  // solver, a factorisation made once here. Its application time counts as
-  // linear solve time.
+  // solver, a factorisation made once here. Building it counts as linear
+  // solve time (set-up as preconditioner set-up); its applications are the
+  // caller's to time.
   std::function<void(const Vector& r, Vector& z)> approximateInverse();
   double linearSolveSeconds() const;
   // The part of linearSolveSeconds() spent setting up preconditioners.

@@ -12,27 +12,21 @@ PressureStep::PressureStep(Assembly& assembly) : assembly_(assembly) {
   auto comm = assembly_.dofMap()->getComm();
   elementMap_ = rcp(new Map(Tpetra::global_size_t(Teuchos::OrdinalTraits<Tpetra::global_size_t>::invalid()), ne,
                             GO(0), comm));
-  freeDofs_ = assembly_.freeDofGlobalIds(bricks);
   weight_ = rcp(new Vector(elementMap_));
   schurInverse_ = rcp(new Vector(elementMap_));
   heldRow_ = rcp(new Vector(elementMap_));
-  // G^T's structure: each element's free dofs. Values come with each solve.
-  gradient_ = rcp(new CrsMatrix(elementMap_, 24));
-  std::vector<GO> cols;
-  std::vector<double> zeros(24, 0.0);
-  for (size_t e = 0; e < ne; ++e) {
-    cols.clear();
-    for (int k = 0; k < 24; ++k)
-      if (freeDofs_[24 * e + k] >= 0) cols.push_back(freeDofs_[24 * e + k]);
-    if (!cols.empty())
-      gradient_->insertGlobalValues(elementMap_->getGlobalElement(LO(e)), Teuchos::ArrayView<const GO>(cols),
-                                    Teuchos::ArrayView<const double>(zeros.data(), cols.size()));
-  }
+  // G^T's structure: each element's free dofs (a rigid core's unknowns for
+  // its face nodes). Values come with each solve.
+  Matrix ones("ones", ne, 24);
+  Kokkos::deep_copy(ones, 1.0);
+  assembly_.chainRows(bricks, ones, rowStart_, cols_, vals_);
+  size_t longest = 1;
+  for (size_t e = 0; e < ne; ++e) longest = std::max(longest, rowStart_[e + 1] - rowStart_[e]);
+  gradient_ = rcp(new CrsMatrix(elementMap_, longest));
+  for (size_t e = 0; e < ne; ++e)
+    if (rowStart_[e + 1] > rowStart_[e])
+      gradient_->insertGlobalValues(elementMap_->getGlobalElement(LO(e)), row(cols_, e), row(vals_, e));
   gradient_->fillComplete(assembly_.dofMap(), elementMap_);
-  auto colMap = gradient_->getColMap();
-  columns_.resize(freeDofs_.size());
-  for (size_t i = 0; i < freeDofs_.size(); ++i)
-    columns_[i] = freeDofs_[i] >= 0 ? colMap->getLocalElement(freeDofs_[i]) : LO(-1);
 }
 
 PressureStep::Block PressureStep::newBlock() const {
@@ -42,6 +36,7 @@ PressureStep::Block PressureStep::newBlock() const {
 void PressureStep::fillVolumeGradient() {
   const BrickEffect& bricks = assembly_.bricks();
   bricks.volumeGradients(assembly_.positions(), g_);
+  assembly_.chainRows(bricks, g_, rowStart_, cols_, vals_);
   auto g = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), g_);
   auto V = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bricks.referenceVolume);
   const double eps = bricks.solvePenalty();
@@ -49,20 +44,14 @@ void PressureStep::fillVolumeGradient() {
   auto sInv = schurInverse_->getDataNonConst();
   auto held = heldRow_->getDataNonConst();
   gradient_->resumeFill();
-  std::vector<LO> cols;
-  std::vector<double> vals;
   for (size_t e = 0; e < g.extent(0); ++e) {
-    cols.clear(), vals.clear();
     double norm2 = 0;
-    for (int k = 0; k < 24; ++k) {
-      norm2 += g(e, k) * g(e, k);
-      if (columns_[24 * e + k] >= 0) cols.push_back(columns_[24 * e + k]), vals.push_back(g(e, k));
-    }
+    for (int k = 0; k < 24; ++k) norm2 += g(e, k) * g(e, k);
     w[e] = std::sqrt(norm2) / (eps * V(e));
     sInv[e] = 1 / (w[e] * eps * V(e));
-    held[e] = cols.empty() ? w[e] * eps * V(e) : 0.0;
-    if (!cols.empty())
-      gradient_->replaceLocalValues(LO(e), Teuchos::ArrayView<const LO>(cols), Teuchos::ArrayView<const double>(vals));
+    const bool empty = rowStart_[e + 1] == rowStart_[e];
+    held[e] = empty ? w[e] * eps * V(e) : 0.0;
+    if (!empty) gradient_->replaceGlobalValues(elementMap_->getGlobalElement(LO(e)), row(cols_, e), row(vals_, e));
   }
   gradient_->fillComplete(assembly_.dofMap(), elementMap_);
 }

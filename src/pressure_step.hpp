@@ -26,8 +26,8 @@
 //
 // The constraint rows are scaled by w_e = |g_e| / (eps V_e): a volume error
 // then counts as the force it causes through the penalty, comparable with R.
-// Held dofs (supports, a rigid core's face nodes) are left out of G: the step
-// keeps them fixed, and the next Newton solve takes up a core's response.
+// G carries a rigid core's face-node entries to the core's free unknowns (as
+// the matrix assembly does); held dofs are left out.
 #pragma once
 
 #include <functional>
@@ -72,8 +72,14 @@ class PressureStep {
   Assembly& assembly_;
   RCP<const Map> elementMap_;
   RCP<CrsMatrix> gradient_;           // G^T: row e holds g_e on the free dofs
-  std::vector<GO> freeDofs_;          // per element, 24 global dof ids (-1 held)
-  std::vector<LO> columns_;           // the same as local columns of gradient_
+  // Element rows of G^T over global dofs (Assembly::chainRows), refilled per solve.
+  std::vector<size_t> rowStart_;
+  std::vector<GO> cols_;
+  std::vector<double> vals_;
+  template <class T>
+  Teuchos::ArrayView<const T> row(const std::vector<T>& v, size_t e) const {
+    return Teuchos::ArrayView<const T>(v.data() + rowStart_[e], rowStart_[e + 1] - rowStart_[e]);
+  }
   Matrix g_;                          // per element g_e (all 24 dofs)
   RCP<Vector> weight_;                // w_e
   RCP<Vector> schurInverse_;          // 1 / (w_e eps V_e)

@@ -178,15 +178,17 @@ ParameterList validParameters() {
   sol.set("Line Search", std::string("Backtrack"), "Backtrack | Polynomial | Full Step (NOX line search)");
   sol.set("Volume Tolerance", 1e-10, "Pressure loop ends when max |v_e/V_e - 1| is below this");
   sol.set("Max Pressure Iterations", 100, "Most pressure-anchor updates per step");
-  sol.set("Pressure Update", std::string("Saddle Point"),
+  sol.set("Pressure Update", std::string("Auto"),
           "How the pressure loop moves the element pressure anchors after each Newton solve: "
-          "Saddle Point (positions and anchors from one block Krylov solve, v_e = V_e to first order) "
-          "or Anderson (pbar <- p(x), Anderson-accelerated)");
+          "Saddle Point (positions and anchors from one block Krylov solve, v_e = V_e to first order), "
+          "Anderson (pbar <- p(x), Anderson-accelerated), or Auto (Saddle Point without friction, "
+          "Anderson with it)");
   sol.set("Pressure Acceleration Depth", 5,
           "Anderson acceleration depth of the pressure loop (0 = plain pbar <- p(x))");
-  sol.set("Minimum Solve Penalty", 1e-2,
+  sol.set("Minimum Solve Penalty", -1.0,
           "Smallest eps1 x c used in the Newton solves: below it the condensed pressure "
-          "cannot be evaluated in double precision; the pressure loop still makes v_e = V_e exact");
+          "cannot be evaluated in double precision; the pressure loop still makes v_e = V_e exact. "
+          "-1: automatic, 3e-2 with the Saddle Point pressure update, 1e-2 with Anderson");
   sol.sublist("NOX", false, "Passed to NOX unchanged, over capstan's defaults");
   sol.sublist("Stratimikos", false, "Passed to Stratimikos unchanged, over capstan's defaults");
 
@@ -974,13 +976,32 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
   oneOf("Predictor", {"Tangent", "Previous"});
   oneOf("Linear Tolerance Method", {"Adaptive", "Fixed"});
   oneOf("Preconditioner Reuse", {"Adaptive", "None"});
-  oneOf("Pressure Update", {"Saddle Point", "Anderson"});
+  oneOf("Pressure Update", {"Auto", "Saddle Point", "Anderson"});
   for (const char* n : {"Linear Tolerance", "Newton Relative Tolerance", "Volume Tolerance"}) {
     const double x = sol.get<double>(n);
     if (!(x > 0 && x < 1)) v.fail(std::string("Solver/") + n, "must be in (0, 1)");
   }
   if (!(sol.get<double>("Newton Absolute Tolerance") >= 0)) v.fail("Solver/Newton Absolute Tolerance", "must be >= 0");
-  positive(sol, "Minimum Solve Penalty", v, "Solver");
+  {
+    const double x = sol.get<double>("Minimum Solve Penalty");
+    if (!(x > 0 || x == -1) || !std::isfinite(x))
+      v.fail("Solver/Minimum Solve Penalty", "must be > 0, or -1 (automatic), got " + Teuchos::toString(x));
+  }
+  // The automatic choices, resolved here so that the run (and its summary)
+  // sees what is used. Pressure Update: the saddle-point step without
+  // friction; with friction the Anderson loop, whose extra passes converge the
+  // path-dependent friction multipliers further than their tolerance (the
+  // saddle-point step met the tolerances but moved H4's finely stepped force
+  // by 1.3e-4 and 1 vs 2 ranks on the pinch roller by 1.5e-7; not measured
+  // faster there). Minimum Solve Penalty: the fastest on G1 for each update
+  // (docs/performance.md): 3e-2 with the saddle-point step, 1e-2 with Anderson.
+  if (sol.get<std::string>("Pressure Update") == "Auto") {
+    const bool friction = std::any_of(sc.capstans.begin(), sc.capstans.end(),
+                                      [](const CapstanSpec& c) { return c.frictionLaw != "None"; });
+    sc.solver.set("Pressure Update", std::string(friction ? "Anderson" : "Saddle Point"));
+  }
+  if (sol.get<double>("Minimum Solve Penalty") == -1)
+    sc.solver.set("Minimum Solve Penalty", sol.get<std::string>("Pressure Update") == "Saddle Point" ? 3e-2 : 1e-2);
   for (const char* n : {"Max Linear Iterations", "Max Newton Iterations", "Max Pressure Iterations"})
     if (sol.get<int>(n) < 1) v.fail(std::string("Solver/") + n, "must be >= 1");
   if (sol.get<int>("ILU Level") < 0) v.fail("Solver/ILU Level", "must be >= 0");

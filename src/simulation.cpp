@@ -183,6 +183,10 @@ class Run {
   // pressure_step.hpp): moves u and the pressure anchors together. False if
   // the block solve made no progress (nothing is changed then).
   bool saddlePointPressureStep(double t, double volumeChange, Vector& f, StepRecord& rec);
+  // Newton's linear solves and the pressure steps' block solves.
+  double linearSolveSeconds() const {
+    return newton_->linearSolveSeconds() + (pressureStep_ ? pressureStep_->seconds() : 0.0);
+  }
   void recordStep(StepRecord& rec);
   CapstanRecord capstanFigures(const ContactEffect& contact, const FrictionEffect* friction) const;
   // Every effect's augmentation multipliers (pressure anchors, contact
@@ -476,7 +480,7 @@ bool Run::solveAt(double t0, double t, StepRecord& rec, std::string& failure) {
       if (!opt_.quiet && rank0_ && std::getenv("CAPSTAN_NEWTON_LOG"))
         std::printf("    %s: %.3e (tolerance %.1e)\n", e->constraintName().c_str(), v, e->constraintTolerance());
       if (v <= e->constraintTolerance()) {
-        if (rolling_ || pressureStep_) settled.push_back(e.get());
+        if (rolling_) settled.push_back(e.get());
         continue;
       }
       met = false;
@@ -492,9 +496,7 @@ bool Run::solveAt(double t0, double t, StepRecord& rec, std::string& failure) {
     if (pressureStep_) {
       // The other multipliers first: the pressure step then re-balances the
       // body under their new values too, so their change does not spoil the
-      // volumes it makes exact. Those within their tolerance stay put (a
-      // settled contact's round-off moves would otherwise set the volume
-      // error each pass leaves, and cost the step its hardest iterations).
+      // volumes it makes exact.
       const std::vector<double> pressureNext = multiplierMap(true);  // at the converged state
       setMultipliers(multiplierMap(false), false, settled);
       if (!volumeMet && !saddlePointPressureStep(t, rec.volumeChange, f, rec))  // no progress: a plain pass instead
@@ -948,7 +950,7 @@ void Run::writeSummary(bool converged, const std::string& failure) {
   Object timing;
   timing.add("total", json::number(total))
       .add("assembly", json::number(assembly_->assemblySeconds() + timingOffset_[1]))
-      .add("linear_solve", json::number(newton_->linearSolveSeconds() + timingOffset_[2]))
+      .add("linear_solve", json::number(linearSolveSeconds() + timingOffset_[2]))
       .add("output", json::number(outputSeconds_ + timingOffset_[3]))
       .add("preconditioner_setup", json::number(newton_->preconditionerSeconds() + timingOffset_[4]));
   Object memory;
@@ -1067,7 +1069,7 @@ std::string Run::checkpointBytes(int step, double time) const {
     for (const auto& r : steps_) putRecord(w, r);
     w.put<double>(since(t0_) + timingOffset_[0]);
     w.put<double>(assembly_->assemblySeconds() + timingOffset_[1]);
-    w.put<double>(newton_->linearSolveSeconds() + timingOffset_[2]);
+    w.put<double>(linearSolveSeconds() + timingOffset_[2]);
     w.put<double>(outputSeconds_ + timingOffset_[3]);
     w.put<double>(newton_->preconditionerSeconds() + timingOffset_[4]);
     for (const auto& e : effects) {

@@ -1,0 +1,71 @@
+#!/usr/bin/env python3
+"""The two pressure updates reach the same converged state.
+
+Solver/Pressure Update = Saddle Point (positions and pressure anchors from one
+block Krylov solve per pass; Auto's choice without friction) and Anderson
+(pbar <- p(x), Anderson-accelerated; Auto's choice with friction) are two
+routes to the same fixed point, v_e = V_e with the contact and friction
+multipliers converged. On
+
+  * seed/g1.xml refined 2x (frictionless indentation, augmented contact),
+    GMRES + MueLu, and
+  * seed/h1.xml (rolling with tanh friction on a soft foundation),
+
+both runs must converge with max |v_e/V_e - 1| <= 1e-10, conform to
+interface.md, and agree on every step's support and capstan forces, the final
+stress and pressure extrema and the face means of the displacement, to 1e-6
+relative to the largest magnitude of their kind (the contact is converged to
+its penetration tolerance, not further, in either run). Also printed: the
+passes and Krylov iterations of each route.
+"""
+import os
+import sys
+
+sys.dont_write_bytecode = True  # nothing written into the source tree
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from capstan_test import Test, has_nan, summary_figures  # noqa: E402
+
+TOL = 1e-6
+T = Test("pressure_update", __doc__)
+
+CASES = [
+    ("g1 2x", "seed/g1.xml", ["Mesh/Cells={28,8,12}", "Time/Steps=2", "Solver/Linear Solver=GMRES",
+                              "Solver/Preconditioner=MueLu"]),
+    ("h1", "seed/h1.xml", []),
+]
+
+for label, scene_name, sets in CASES:
+    scene = T.input(scene_name)
+    runs = {}
+    for method in ("Saddle Point", "Anderson"):
+        tag = f"{label.replace(' ', '-')}-{method.split()[0].lower()}"
+        p, s, out = T.run_scene(scene, tag, sets=sets + [f"Solver/Pressure Update={method}"])
+        if s is None:
+            T.check(False, f"{label} {method}: no summary.json")
+            continue
+        T.check(s["converged"] is True, f"{label} {method}: converged = {s['converged']} ({s['failure']!r})")
+        T.check(not has_nan(s), f"{label} {method}: no NaN in summary.json")
+        dv = s["final"]["max_abs_volume_change"]
+        T.check(dv <= 1e-10, f"{label} {method}: final.max_abs_volume_change = {dv:.2e} (<= 1e-10)")
+        T.conforms(out, scene)
+        passes = sum(st["augmentations"] for st in s["steps"])
+        linear = sum(st["linear_iterations"] for st in s["steps"])
+        newton = sum(st["newton_iterations"] for st in s["steps"])
+        print(f"  {label} {method}: {passes} passes, {newton} Newton iterations, {linear} Krylov iterations, "
+              f"{s['timing']['total']:.2f} s")
+        if s["converged"] is True:
+            runs[method] = summary_figures(s)
+    if len(runs) < 2:
+        continue
+    a, b = runs["Saddle Point"], runs["Anderson"]
+    for group in ("force", "stress", "displacement"):
+        scale = max(abs(v) for v in b[group].values())
+        worst, where = 0.0, ""
+        for name, ref in b[group].items():
+            d = abs(a[group].get(name, float("nan")) - ref) / scale
+            if not d <= worst:
+                worst, where = d, name
+        T.check(worst <= TOL, f"{label}: {group} figures agree: worst {worst:.2e} of the largest "
+                f"{scale:.4g} ({where}) (<= {TOL:g})")
+
+T.finish()
