@@ -14,10 +14,14 @@ count runs the same method, and writes
     scripts/scaling.py [--out out/scaling] [--g1 1,2,4] [--h1 2,4,8] [--ranks 1,2]
                        [--steps N] [--capstan build/capstan]
 
-Runs whose summary.json exists are reused (delete OUT/<run>/ to redo one).
+Runs whose summary.json exists are reused (delete OUT/<run>/ to redo one); a
+run made by hand may leave its CAPSTAN_NEWTON_LOG=1 output in OUT/<run>/run.log,
+from which the pressure steps' iterations are read if its summary lacks them.
 --steps N runs only the first N steps of each scene (the per-step and
 per-Newton figures stay comparable; the totals do not). The 8x G1 (550k
-DOFs) takes hours on this machine kind: see docs/performance.md.
+DOFs, --g1 8) takes about 9 minutes on 2 ranks and 20 on 1 (docs/performance.md).
+"linear" counts every Krylov iteration: Newton's solves and the saddle-point
+pressure steps (split out in their own columns).
 """
 import argparse
 import csv
@@ -71,11 +75,21 @@ for case, f in plan:
         steps = s["steps"]
         newton = sum(st["newton_iterations"] for st in steps)
         linear = sum(st["linear_iterations"] for st in steps)
+        # Krylov iterations of the saddle-point pressure steps (part of linear;
+        # absent from summaries written before the key existed).
+        pstep = (sum(st["pressure_step_iterations"] for st in steps)
+                 if all("pressure_step_iterations" in st for st in steps) else None)
+        log = os.path.join(out, "run.log")  # a run made by hand with CAPSTAN_NEWTON_LOG=1
+        if pstep is None and os.path.isfile(log):
+            with open(log) as fh:
+                pstep = sum(int(line.split()[2]) for line in fh if line.strip().startswith("pressure step:"))
         t = s["timing"]
         rows.append({
             "case": case, "factor": f, "cells": "x".join(map(str, cells)), "ranks": ranks,
             "dofs": s["mesh"]["dofs"], "steps": len(steps), "converged": s["converged"],
             "newton": newton, "linear": linear, "linear_per_newton": round(linear / max(newton, 1), 1),
+            "pressure_step_linear": pstep,
+            "newton_linear_per_newton": None if pstep is None else round((linear - pstep) / max(newton, 1), 1),
             "augmentations": sum(st["augmentations"] for st in steps),
             "total_s": round(t["total"], 2), "per_step_s": round(t["total"] / max(len(steps), 1), 3),
             "per_newton_s": round(t["total"] / max(newton, 1), 4),
@@ -90,13 +104,15 @@ with open(os.path.join(args.out, "scaling.csv"), "w", newline="") as fh:
     w.writeheader()
     w.writerows(rows)
 
-head = ["case", "cells", "ranks", "dofs", "Newton", "linear", "linear/Newton", "pressure passes",
+head = ["case", "cells", "ranks", "dofs", "Newton", "linear", "linear/Newton", "of it: pressure steps",
+        "Newton's linear/Newton", "pressure passes",
         "s/Newton", "s/step", "total s", "assembly s", "prec. set-up s", "linear solve s", "peak MiB/rank"]
 lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
 for r in rows:
     lines.append("| " + " | ".join(str(x) for x in [
         r["case"], r["cells"], r["ranks"], r["dofs"], r["newton"], r["linear"], r["linear_per_newton"],
-        r["augmentations"], r["per_newton_s"], r["per_step_s"], r["total_s"], r["assembly_s"],
+        "n/a" if r["pressure_step_linear"] is None else r["pressure_step_linear"],
+        "n/a" if r["newton_linear_per_newton"] is None else r["newton_linear_per_newton"], r["augmentations"], r["per_newton_s"], r["per_step_s"], r["total_s"], r["assembly_s"],
         r["preconditioner_setup_s"], r["linear_solve_s"], r["peak_mib_per_rank"]]) +
         ("" if r["converged"] else " (did not converge)") + " |")
 lines += ["", "2 ranks against 1 (total wall time, same run set):", ""]

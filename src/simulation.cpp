@@ -14,13 +14,13 @@
 #include <sstream>
 
 #include "anderson.hpp"
-#include "pressure_step.hpp"
 #include "assembly.hpp"
 #include "checkpoint.hpp"
 #include "errors.hpp"
 #include "field_writer.hpp"
 #include "json.hpp"
 #include "newton.hpp"
+#include "pressure_step.hpp"
 
 namespace capstan {
 
@@ -29,13 +29,13 @@ namespace fs = std::filesystem;
 namespace {
 
 using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
 // The saddle-point pressure step's GMRES tolerance (relative): the volume
 // error then falls about 1000x per pass in the linear regime.
 constexpr double kPressureStepTolerance = 1e-3;
-double since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 
 MPI_Comm rawComm(const RCP<const Comm>& comm) {
   auto mpi = Teuchos::rcp_dynamic_cast<const Teuchos::MpiComm<int>>(comm);
@@ -69,6 +69,7 @@ struct StepRecord {
   int step = 0;
   double time = 0;
   int newton = 0, linear = 0, cutbacks = 0, augmentations = 0;
+  int pressureStep = 0;  // Krylov iterations of the saddle-point pressure steps (part of linear)
   double residual = 0, wall = 0, volumeChange = 0;
   std::vector<SupportRecord> supports;
   std::vector<CapstanRecord> capstans;
@@ -124,7 +125,7 @@ void agreeRuntime(const Comm& comm, std::string error) {
 // history.csv list for the steps before the restart.
 void putRecord(checkpoint::Writer& w, const StepRecord& r) {
   w.put(r.step), w.put(r.time), w.put(r.newton), w.put(r.linear), w.put(r.cutbacks);
-  w.put(r.augmentations), w.put(r.residual), w.put(r.wall), w.put(r.volumeChange);
+  w.put(r.augmentations), w.put(r.residual), w.put(r.wall), w.put(r.volumeChange), w.put(r.pressureStep);
   w.put<int>(int(r.supports.size()));
   for (const auto& s : r.supports) {
     w.put(s.name), w.put(s.force), w.put(s.core), w.put(s.torque), w.put(s.rotation), w.put(s.angularVelocity);
@@ -143,6 +144,7 @@ StepRecord getRecord(checkpoint::Reader& in) {
   r.step = in.get<int>(), r.time = in.get<double>(), r.newton = in.get<int>();
   r.linear = in.get<int>(), r.cutbacks = in.get<int>(), r.augmentations = in.get<int>();
   r.residual = in.get<double>(), r.wall = in.get<double>(), r.volumeChange = in.get<double>();
+  r.pressureStep = in.get<int>();
   const int ns = in.get<int>();
   for (int i = 0; i < ns; ++i) {
     auto name = in.getString();
@@ -527,9 +529,15 @@ bool Run::saddlePointPressureStep(double t, double volumeChange, Vector& f, Step
   // only the hardest (nearly spurious) pressure modes left.
   const double need = 0.1 * bricks.constraintTolerance() / volumeChange;
   const double tolerance = std::min(0.1, std::max(kPressureStepTolerance, need));
-  const auto step = pressureStep_->solve(*W, newton_->approximateInverse(), f, tolerance,
-                                         scene_.solver.get<int>("Max Linear Iterations"), dx, dp);
+  PressureStep::Result step;
+  try {
+    step = pressureStep_->solve(*W, newton_->approximateInverse(), f, tolerance,
+                                scene_.solver.get<int>("Max Linear Iterations"), dx, dp);
+  } catch (const std::exception&) {  // e.g. a preconditioner that cannot be built: a plain pass
+    return false;
+  }
   rec.linear += step.iterations;
+  rec.pressureStep += step.iterations;
   if (!opt_.quiet && rank0_ && std::getenv("CAPSTAN_NEWTON_LOG"))
     std::printf("    pressure step: %d GMRES iterations, residual reduced %.2e\n", step.iterations, step.reduction);
   if (!(step.reduction < 1)) return false;
@@ -920,6 +928,7 @@ void Run::writeSummary(bool converged, const std::string& failure) {
     o.add("step", json::number(r.step)).add("time", json::number(r.time))
         .add("newton_iterations", json::number(r.newton))
         .add("linear_iterations", json::number(r.linear))
+        .add("pressure_step_iterations", json::number(r.pressureStep))
         .add("cutbacks", json::number(r.cutbacks))
         .add("augmentations", json::number(r.augmentations))
         .add("residual_norm", json::number(r.residual))
