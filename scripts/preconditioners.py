@@ -8,6 +8,11 @@ tolerances, a reused preconditioner) switched off one at a time.
     scripts/preconditioners.py [--out out/preconditioners] [--factors 1,2,4]
                                [--ranks 1] [--quick]
 
+--pressure-update: Solver/Pressure Update of every run (default Anderson,
+with the solve penalty it had then, 1e-2: the pressure loop of the figures in
+docs/performance.md; Auto runs today's default, the saddle-point step, whose
+own figures are in the "pressure loop" section there).
+
 --quick: the 1x and 2x meshes only. Runs whose summary.json exists are
 reused. Writes OUT/preconditioners.md and .csv (one row per run) and prints
 the table: Newton and linear iterations, linear iterations per Newton
@@ -29,6 +34,7 @@ ap.add_argument("--capstan", default=os.path.join(root, "build", "capstan"))
 ap.add_argument("--factors", default="1,2,4")
 ap.add_argument("--ranks", type=int, default=1)
 ap.add_argument("--quick", action="store_true")
+ap.add_argument("--pressure-update", default="Anderson", choices=["Anderson", "Saddle Point", "Auto"])
 args = ap.parse_args()
 factors = [1, 2] if args.quick else [int(x) for x in args.factors.split(",")]
 env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
@@ -103,6 +109,9 @@ for group, label, tag, solver, strat, sets in runs:
         cmd = [args.capstan, "run", scene, "--output", out, "--quiet", "--set", "Output/Write Fields=false"]
         for s in sets:
             cmd += ["--set", s]
+        cmd += ["--set", f"Solver/Pressure Update={args.pressure_update}"]
+        if args.pressure_update == "Anderson" and not any(s.startswith("Solver/Minimum Solve Penalty") for s in sets):
+            cmd += ["--set", "Solver/Minimum Solve Penalty=1e-2"]
         if args.ranks > 1:
             cmd = ["mpiexec", "--oversubscribe", "-n", str(args.ranks)] + cmd
         print("  " + label, flush=True)

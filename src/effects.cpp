@@ -24,6 +24,18 @@ void Effect::evaluate(const NodalVectors& x, const NodalVectors& u, bool tangent
 
 namespace {
 
+// One brick's reference (X) and current (x) node positions, from the effect's
+// per-brick reference coordinates and the overlapped nodes' positions.
+template <class Nodes, class Reference>
+KOKKOS_INLINE_FUNCTION void gatherBrick(int e, const Nodes& nodes, const Reference& X, const NodalVectors& x,
+                                        double Xe[8][3], double xe[8][3]) {
+  for (int a = 0; a < 8; ++a)
+    for (int i = 0; i < 3; ++i) {
+      Xe[a][i] = X(e, a, i);
+      xe[a][i] = x(nodes(e, a), i);
+    }
+}
+
 // Dof ids of entities given by their node ids.
 template <class NodeView>
 IntMatrix dofsOf(const NodeView& nodes) {
@@ -96,11 +108,7 @@ void BrickEffect::launch(const NodalVectors& x, const NodalVectors&, bool tangen
       "brick residual+tangent", Kokkos::RangePolicy<ExecSpace>(0, nodes.extent(0)),
       KOKKOS_LAMBDA(int e) {
         double Xe[8][3], xe[8][3];
-        for (int a = 0; a < 8; ++a)
-          for (int i = 0; i < 3; ++i) {
-            Xe[a][i] = X(e, a, i);
-            xe[a][i] = x(nodes(e, a), i);
-          }
+        gatherBrick(e, nodes, X, x, Xe, xe);
         kernels::BrickState st;
         kernels::brickResidualTangent(Xe, xe, V(e), pbar(e), c, eps, &R(e, 0),
                                       tangent ? &K(e, 0, 0) : nullptr, st);
@@ -118,11 +126,7 @@ void BrickEffect::volumeGradients(const NodalVectors& x, Matrix& g) const {
   Kokkos::parallel_for(
       "brick volume gradient", Kokkos::RangePolicy<ExecSpace>(0, nodes.extent(0)), KOKKOS_LAMBDA(int e) {
         double Xe[8][3], xe[8][3];
-        for (int a = 0; a < 8; ++a)
-          for (int i = 0; i < 3; ++i) {
-            Xe[a][i] = X(e, a, i);
-            xe[a][i] = x(nodes(e, a), i);
-          }
+        gatherBrick(e, nodes, X, x, Xe, xe);
         kernels::brickVolumeGradient(Xe, xe, &out(e, 0));
       });
 }
@@ -158,11 +162,7 @@ void BrickEffect::centroidStress(const NodalVectors& x, Matrix& stress,
       "brick centroid stress", Kokkos::RangePolicy<ExecSpace>(0, nodes.extent(0)),
       KOKKOS_LAMBDA(int e) {
         double Xe[8][3], xe[8][3], sig[6];
-        for (int a = 0; a < 8; ++a)
-          for (int i = 0; i < 3; ++i) {
-            Xe[a][i] = X(e, a, i);
-            xe[a][i] = x(nodes(e, a), i);
-          }
+        gatherBrick(e, nodes, X, x, Xe, xe);
         kernels::brickCentroidStress(Xe, xe, p(e), c, sig);
         for (int k = 0; k < 6; ++k) s(e, k) = sig[k];
         m(e) = kernels::vonMises(sig);
