@@ -246,7 +246,7 @@ void Assembly::assembleCoreCoupling(FEMatrix& W) {
       for (int k = 0; k < n; ++k) {
         const int d = dofs(e, k), c = coreOfNode_[d / 3];
         coreOf[k] = c;
-        if (c >= 0) B[k] = {d % 3 == 0 ? 1.0 : 0.0, d % 3 == 1 ? 1.0 : 0.0, d % 3 == 2 ? 1.0 : 0.0, followers_[d / 3].b[d % 3]};
+        if (c >= 0) B[k] = coreChain(d);
       }
       for (int k = 0; k < n; ++k)
         for (int l = 0; l < n; ++l) {
@@ -365,9 +365,13 @@ void Assembly::chainRows(const Effect& e, const Matrix& values, std::vector<size
         if (supportOf[d] < 0) add(gid(d), v(k, j));
         continue;
       }
+      // The core's free unknowns this dof moves with: its own translation
+      // component and the rotation (kept even where du/dtheta is 0, so that
+      // every evaluation has the same columns).
       const RigidCore& core = cores_[c];
-      if (core.free[d % 3]) add(gid(core.firstDof + d % 3), v(k, j));
-      if (core.free[3]) add(gid(core.firstDof + 3), v(k, j) * followers_[d / 3].b[d % 3]);
+      const auto B = coreChain(d);
+      for (int q = 0; q < 4; ++q)
+        if (core.free[q] && (q == 3 || q == d % 3)) add(gid(core.firstDof + q), v(k, j) * B[q]);
     }
     rowStart.push_back(cols.size());
   }

@@ -149,6 +149,12 @@ class Assembly {
   // Sums over the owned core nodes of v (owned values, a residual or K z): per
   // core {force (3), torque, R . w}, global.
   std::vector<std::array<double, 5>> coreSums(const Teuchos::ArrayRCP<const double>& v) const;
+  // d u_dof / d (Tx, Ty, Tz, theta) of the core that a face-node dof follows
+  // (at the cores' last q): the chain rule's coefficients.
+  std::array<double, 4> coreChain(int dof) const {
+    const int i = dof % 3;
+    return {i == 0 ? 1.0 : 0.0, i == 1 ? 1.0 : 0.0, i == 2 ? 1.0 : 0.0, followers_[dof / 3].b[i]};
+  }
   // The chain rule at the cores' face nodes: element-matrix entries that touch
   // a face node, carried to the core's free unknowns.
   void assembleCoreCoupling(FEMatrix& W);

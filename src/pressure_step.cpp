@@ -14,7 +14,7 @@ PressureStep::PressureStep(Assembly& assembly) : assembly_(assembly) {
                             GO(0), comm));
   weight_ = rcp(new Vector(elementMap_));
   schurInverse_ = rcp(new Vector(elementMap_));
-  heldRow_ = rcp(new Vector(elementMap_));
+  scratch_ = rcp(new Vector(assembly_.dofMap()));
   // G^T's structure: each element's free dofs (a rigid core's unknowns for
   // its face nodes). Values come with each solve.
   Matrix ones("ones", ne, 24);
@@ -42,15 +42,15 @@ void PressureStep::fillVolumeGradient() {
   const double eps = bricks.solvePenalty();
   auto w = weight_->getDataNonConst();
   auto sInv = schurInverse_->getDataNonConst();
-  auto held = heldRow_->getDataNonConst();
   gradient_->resumeFill();
   for (size_t e = 0; e < g.extent(0); ++e) {
     double norm2 = 0;
     for (int k = 0; k < 24; ++k) norm2 += g(e, k) * g(e, k);
-    w[e] = std::sqrt(norm2) / (eps * V(e));
-    sInv[e] = 1 / (w[e] * eps * V(e));
+    // An element with no free dof (all its nodes held) has no constraint row:
+    // weight 0 keeps its equation and its dp at 0.
     const bool empty = rowStart_[e + 1] == rowStart_[e];
-    held[e] = empty ? w[e] * eps * V(e) : 0.0;
+    w[e] = empty ? 0.0 : std::sqrt(norm2) / (eps * V(e));
+    sInv[e] = empty ? 0.0 : 1 / (w[e] * eps * V(e));
     if (!empty) gradient_->replaceGlobalValues(elementMap_->getGlobalElement(LO(e)), row(cols_, e), row(vals_, e));
   }
   gradient_->fillComplete(assembly_.dofMap(), elementMap_);
@@ -60,18 +60,17 @@ void PressureStep::applySystem(const CrsMatrix& K, const Block& x, Block& y) con
   // y_u = K x_u - G x_p
   K.apply(*x.u, *y.u);
   gradient_->apply(*x.p, *y.u, Teuchos::TRANS, -1.0, 1.0);
-  // y_p = w .* (G^T x_u) (+ the identity-like rows of elements with no free dof)
+  // y_p = w .* (G^T x_u)
   gradient_->apply(*x.u, *y.p);
   y.p->elementWiseMultiply(1.0, *weight_, *y.p, 0.0);
-  y.p->elementWiseMultiply(1.0, *heldRow_, *x.p, 1.0);
 }
 
-void PressureStep::applyPreconditioner(const Inverse& Kinv, const Block& r, Block& z) const {
+void PressureStep::applyPreconditioner(const Inverse& Kinv, const Block& r, Block& z) {
   // z_p = (w eps M)^-1 r_p, then z_u = K~^-1 (r_u + G z_p)
   z.p->elementWiseMultiply(1.0, *schurInverse_, *r.p, 0.0);
-  Vector t(*r.u, Teuchos::Copy);
-  gradient_->apply(*z.p, t, Teuchos::TRANS, 1.0, 1.0);
-  Kinv(t, *z.u);
+  scratch_->update(1.0, *r.u, 0.0);
+  gradient_->apply(*z.p, *scratch_, Teuchos::TRANS, 1.0, 1.0);
+  Kinv(*scratch_, *z.u);
 }
 
 PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv, const Vector& f, double tolerance,
@@ -79,7 +78,7 @@ PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv
   Kokkos::Timer timer;
   fillVolumeGradient();
   const BrickEffect& bricks = assembly_.bricks();
-  // Right-hand side: (-R, w .* (V - v)); rows of elements with no free dof: 0.
+  // Right-hand side: (-R, w .* (V - v)).
   Block rhs = newBlock();
   rhs.u->update(-1.0, f, 0.0);
   {
@@ -87,8 +86,7 @@ PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv
     auto V = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bricks.referenceVolume);
     auto r = rhs.p->getDataNonConst();
     auto w = weight_->getData();
-    auto held = heldRow_->getData();
-    for (size_t e = 0; e < v.extent(0); ++e) r[e] = held[e] > 0 ? 0.0 : w[e] * (V(e) - v(e));
+    for (size_t e = 0; e < v.extent(0); ++e) r[e] = w[e] * (V(e) - v(e));
   }
   Block x = newBlock(), work = newBlock(), z = newBlock();
   const double beta0 = std::sqrt(dot(rhs, rhs));

@@ -67,7 +67,7 @@ class PressureStep {
   void fillVolumeGradient();
   // y = A x (the scaled saddle-point matrix) and z = P^-1 r.
   void applySystem(const CrsMatrix& K, const Block& x, Block& y) const;
-  void applyPreconditioner(const Inverse& Kinv, const Block& r, Block& z) const;
+  void applyPreconditioner(const Inverse& Kinv, const Block& r, Block& z);
 
   Assembly& assembly_;
   RCP<const Map> elementMap_;
@@ -81,9 +81,9 @@ class PressureStep {
     return Teuchos::ArrayView<const T>(v.data() + rowStart_[e], rowStart_[e + 1] - rowStart_[e]);
   }
   Matrix g_;                          // per element g_e (all 24 dofs)
-  RCP<Vector> weight_;                // w_e
-  RCP<Vector> schurInverse_;          // 1 / (w_e eps V_e)
-  RCP<Vector> heldRow_;               // w_e eps V_e where g_e has no free dof, else 0
+  RCP<Vector> weight_;                // w_e (0 for an element with no free dof)
+  RCP<Vector> schurInverse_;          // 1 / (w_e eps V_e) (0 likewise)
+  RCP<Vector> scratch_;               // applyPreconditioner's r_u + G z_p
   std::vector<Block> basis_;          // GMRES's Krylov basis, kept between solves
   double seconds_ = 0;
 };
