@@ -540,7 +540,10 @@ bool Assembly::evaluate(const Vector& u, Vector* f, FEMatrix* W) {
 
   if (W) {
     // Element matrices are added straight into the local CRS values at their
-    // precomputed offsets, in a parallel loop (atomic: entities share entries).
+    // precomputed offsets, in a parallel loop (atomic: entities share entries;
+    // not where the loop runs on one thread, where an atomic add of a double
+    // is a compare-and-swap loop for nothing).
+    constexpr bool kSerial = std::is_same_v<ExecSpace, Kokkos::Serial>;
     W->beginAssembly();
     W->setAllToScalar(0.0);
     const auto values = W->getLocalMatrixDevice().values;
@@ -557,7 +560,9 @@ bool Assembly::evaluate(const Vector& u, Vector* f, FEMatrix* W) {
             for (int k = 0; k < n; ++k)
               for (int l = 0; l < n; ++l) {
                 const long o = offsets(e, k, l);
-                if (o >= 0) Kokkos::atomic_add(&values(o), K(e, k, l));
+                if (o < 0) continue;
+                if constexpr (kSerial) values(o) += K(e, k, l);
+                else Kokkos::atomic_add(&values(o), K(e, k, l));
               }
           });
     }
