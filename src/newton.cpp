@@ -277,8 +277,19 @@ Teuchos::ParameterList stratimikosParameters(const Teuchos::ParameterList& solve
       ml.set("verbosity", "none");
       ml.set("number of equations", 3);
       ml.set("multigrid algorithm", "sa");
-      ml.set("smoother: type", "CHEBYSHEV");
-      ml.sublist("smoother: params").set("chebyshev: degree", 2);
+      // capstan's smoother, unless the scene picks another in
+      // Solver/Stratimikos/Preconditioner Types/MueLu/smoother: type (then
+      // that smoother's defaults: MueLu rejects a Chebyshev degree for it).
+      std::string userSmoother = "CHEBYSHEV";
+      const auto& strat = solver.sublist("Stratimikos");
+      if (strat.isSublist("Preconditioner Types") && strat.sublist("Preconditioner Types").isSublist("MueLu")) {
+        const auto& user = strat.sublist("Preconditioner Types").sublist("MueLu");
+        if (user.isType<std::string>("smoother: type")) userSmoother = user.get<std::string>("smoother: type");
+      }
+      if (userSmoother == "CHEBYSHEV") {
+        ml.set("smoother: type", "CHEBYSHEV");
+        ml.sublist("smoother: params").set("chebyshev: degree", 2);
+      }
       ml.set("coarse: max size", 1500);
       ml.set("Nullspace", nullspace);
     } else {
