@@ -80,11 +80,8 @@ KOKKOS_INLINE_FUNCTION void brickReferenceGradients(const BrickGaussPoints& q, i
                 dN.byNode[gp][2][a] * q.J0inv[2][J][gp];
 }
 
-// Current volume of the element (2x2x2 Gauss) and the smallest Gauss-point J.
-KOKKOS_INLINE_FUNCTION double brickVolume(const double X[8][3], const double x[8][3],
-                                          double& minJ) {
-  BrickGaussPoints q;
-  brickGaussPoints(X, x, q);
+// Current volume (the sum of the volume elements) and the smallest det F.
+KOKKOS_INLINE_FUNCTION double brickVolume(const BrickGaussPoints& q, double& minJ) {
   double v = 0;
   minJ = 1e300;
   for (int gp = 0; gp < 8; ++gp) {
@@ -92,6 +89,14 @@ KOKKOS_INLINE_FUNCTION double brickVolume(const double X[8][3], const double x[8
     v += q.wJ[gp];
   }
   return v;
+}
+
+// Current volume of the element (2x2x2 Gauss) and the smallest Gauss-point J.
+KOKKOS_INLINE_FUNCTION double brickVolume(const double X[8][3], const double x[8][3],
+                                          double& minJ) {
+  BrickGaussPoints q;
+  brickGaussPoints(X, x, q);
+  return brickVolume(q, minJ);
 }
 
 // g = d v / d x (24, dof 3a+i) = int J F^{-T} D_a dV: how the element's
@@ -184,13 +189,8 @@ KOKKOS_INLINE_FUNCTION void brickKernel(const double X[8][3], const double x[8][
                                         double c, double eps, double* R, double* K, BrickState& out) {
   BrickGaussPoints q;
   brickGaussPoints(X, x, q);
-  double v = 0, minJ = 1e300;
-  for (int gp = 0; gp < 8; ++gp) {
-    minJ = q.J[gp] < minJ ? q.J[gp] : minJ;
-    v += q.wJ[gp];
-  }
+  const double v = brickVolume(q, out.minJ);
   out.volume = v;
-  out.minJ = minJ;
   const double p = pbar - (v - V) / (eps * V);
   out.pressure = p;
   const double c2 = 2 * c, qs = p + c2;  // sigma = -q I + 2c B

@@ -148,6 +148,19 @@ def rel_diff(a, b, scale=None):
     return abs(a - b) / s if s > 0 else math.inf
 
 
+def worst_difference(ref, other):
+    """The largest |other[k] - ref[k]| over REF's names, relative to REF's largest
+    magnitude; a name missing from OTHER counts as NaN (fails any tolerance).
+    Returns (worst, its name, scale)."""
+    scale = max(abs(v) for v in ref.values())
+    worst, where = 0.0, next(iter(ref), "")
+    for name, v in ref.items():
+        d = abs(other.get(name, math.nan) - v) / scale
+        if not d <= worst:
+            worst, where = d, name
+    return worst, where, scale
+
+
 def has_nan(obj):
     """True if a float in OBJ (nested dicts/lists) is NaN or infinite."""
     if isinstance(obj, float):

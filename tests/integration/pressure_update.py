@@ -23,7 +23,7 @@ import sys
 
 sys.dont_write_bytecode = True  # nothing written into the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from capstan_test import Test, has_nan, summary_figures  # noqa: E402
+from capstan_test import Test, has_nan, summary_figures, worst_difference  # noqa: E402
 
 TOL = 1e-6
 T = Test("pressure_update", __doc__)
@@ -59,12 +59,7 @@ for label, scene_name, sets in CASES:
         continue
     a, b = runs["Saddle Point"], runs["Anderson"]
     for group in ("force", "stress", "displacement"):
-        scale = max(abs(v) for v in b[group].values())
-        worst, where = 0.0, ""
-        for name, ref in b[group].items():
-            d = abs(a[group].get(name, float("nan")) - ref) / scale
-            if not d <= worst:
-                worst, where = d, name
+        worst, where, scale = worst_difference(b[group], a[group])
         T.check(worst <= TOL, f"{label}: {group} figures agree: worst {worst:.2e} of the largest "
                 f"{scale:.4g} ({where}) (<= {TOL:g})")
 
