@@ -427,6 +427,26 @@ NewtonSolver::NewtonSolver(Assembly& assembly, const Teuchos::ParameterList& sol
   }
   impl_->model = rcp(new BodyModel(assembly, impl_->lows));
   impl_->W = impl_->model->create_W_op();
+  // MueLu and Ifpack2 read their parameters only when a preconditioner is
+  // built. A scene that passes its own (Solver/Stratimikos/Preconditioner
+  // Types) gets one built now, on the tangent at the undeformed state, so that
+  // a bad name or value stops the run before anything is written.
+  const auto& strat = solver.sublist("Stratimikos");
+  if (!impl_->newtonPrecFactory.is_null() && strat.isSublist("Preconditioner Types")) {
+    try {
+      Vector zero(assembly.dofMap());
+      auto K = assembly.createMatrix();
+      assembly.evaluate(zero, nullptr, K.get());
+      RCP<const Thyra::LinearOpBase<double>> op = Thyra::createConstLinearOp(RCP<const Tpetra::Operator<>>(K));
+      auto factory = builder.createPreconditioningStrategy("");
+      auto trial = factory->createPrec();
+      factory->initializePrec(Thyra::defaultLinearOpSource<double>(op), trial.get());
+    } catch (const std::exception& e) {
+      std::string what = e.what();
+      what = what.substr(0, what.find("The valid parameters and types are"));  // a page of them
+      throw InputError("parameter 'Solver/Stratimikos/Preconditioner Types': " + trilinosMessage(what));
+    }
+  }
   try {
     auto guess = rcp(new Vector(assembly.dofMap()));
     NOX::Thyra::Vector x0(Thyra::createVector(guess, impl_->model->get_x_space()));

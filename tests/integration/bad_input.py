@@ -9,7 +9,7 @@ must stay empty. Classes: wrong types, out-of-range values, wrong array lengths,
 unknown face names, a zero axis direction, Radius <= 0, malformed XML (unclosed,
 mismatched, duplicated, too deeply nested, unknown elements), an empty file,
 binary garbage, a missing scene file, an output directory under a regular file,
-bad NOX and Stratimikos sublists, a mesh with fewer cells than ranks, and bad
+bad NOX and Stratimikos sublists (MueLu's own parameters too), a mesh with fewer cells than ranks, and bad
 --set values.
 
 Then the warning for a capstan that can never touch its contact faces: printed
@@ -203,6 +203,18 @@ bad_value("Stratimikos: unknown solver", [('<ParameterList name="Output">',
                                            '<Parameter name="Linear Solver Type" type="string" value="Bogus"/>'
                                            '</ParameterList></ParameterList><ParameterList name="Output">')],
           "Solver/Stratimikos")
+# MueLu reads its list only when it builds a preconditioner: capstan builds one before
+# the run when a scene passes its own (an unknown smoother, a value of the wrong type).
+for label, param in (("MueLu: unknown smoother", '<Parameter name="smoother: type" type="string" value="Bogus"/>'),
+                     ("MueLu: wrong type", '<Parameter name="aggregation: drop tol" type="string" value="abc"/>')):
+    f = scene_file(label.replace(" ", "_").replace(":", "") + ".xml", edited((
+        '<ParameterList name="Output">',
+        '<ParameterList name="Solver"><Parameter name="Linear Solver" type="string" value="GMRES"/>'
+        '<Parameter name="Preconditioner" type="string" value="MueLu"/><ParameterList name="Stratimikos">'
+        '<ParameterList name="Preconditioner Types"><ParameterList name="MueLu">' + param +
+        '</ParameterList></ParameterList></ParameterList></ParameterList><ParameterList name="Output">')))
+    case(label, f, [f, "Solver/Stratimikos/Preconditioner Types"])
+    case(label + ", 2 ranks", f, [f, "Solver/Stratimikos/Preconditioner Types"], ranks=2, outdir_kinds=("missing",))
 f = scene_file("one-cell.xml", edited(('value="{14, 4, 6}"', 'value="{1, 1, 1}"')))
 case("one cell on 2 ranks", f, [f, "Mesh/Cells"], ranks=2)
 case("--set: 1e999", good, [good, "Material/c"], args=["--set", "Material/c=1e999"])
