@@ -386,16 +386,17 @@ NewtonSolver::NewtonSolver(Assembly& assembly, const Teuchos::ParameterList& sol
   builder.setPreconditioningStrategyFactory(Teuchos::abstractFactoryStd<PrecBase, Ifpack2Factory>(),
                                             "Ifpack2");
   Stratimikos::enableMueLu(builder);
-  // Amesos2's KLU2 on several ranks gave wrong solutions with a rigid core's
-  // rows (Newton stalled where GMRES converged; docs/pinch-roller.md): there,
-  // Direct falls back to GMRES, and says so.
+  // Amesos2's KLU2 on several ranks solves our matrices wrongly in Trilinos
+  // 13.2 (Newton stalls: G1 and H1 end with exit 2; first seen with a rigid
+  // core's rows, docs/pinch-roller.md): there, Direct falls back to GMRES, and
+  // says so.
   Teuchos::ParameterList chosen(solver);
   const int ranks = assembly.dofMap()->getComm()->getSize();
-  if (ranks > 1 && !assembly.rigidCores().empty() && solver.get<std::string>("Linear Solver") == "Direct") {
+  if (ranks > 1 && solver.get<std::string>("Linear Solver") == "Direct") {
     chosen.set("Linear Solver", std::string("GMRES"));
     if (assembly.dofMap()->getComm()->getRank() == 0)
-      std::fprintf(stderr, "capstan: note: Solver/Linear Solver = Direct is not reliable with a Rigid Core on %d "
-                           "ranks; using GMRES\n", ranks);
+      std::fprintf(stderr, "capstan: note: Solver/Linear Solver = Direct is not reliable on %d ranks "
+                           "(Amesos2 KLU2 in Trilinos 13.2); using GMRES\n", ranks);
   }
   impl_->strat = stratimikosParameters(chosen, long(assembly.dofMap()->getGlobalNumElements()),
                                        assembly.dofMap()->getComm()->getSize(),
@@ -518,6 +519,10 @@ std::function<void(const Vector&, Vector&)> NewtonSolver::approximateInverse() {
     z.putScalar(0.0);
     Thyra::solve<double>(*lows, Thyra::NOTRANS, *rt, zt.ptr());
   };
+}
+
+int NewtonSolver::preconditionerBuilds() const {
+  return impl_->newtonPrecFactory.is_null() ? 0 : impl_->newtonPrecFactory->builds();
 }
 
 void NewtonSolver::rebuildPreconditioner() {

@@ -49,6 +49,8 @@ class NewtonSolver {
   double linearSolveSeconds() const;
   // The part of linearSolveSeconds() spent setting up preconditioners.
   double preconditionerSeconds() const;
+  // Preconditioners Newton has built so far (the lagged one; CAPSTAN_NEWTON_LOG).
+  int preconditionerBuilds() const;
   // The linear solver and preconditioner parameters in use (Stratimikos list).
   const Teuchos::ParameterList& linearSolverParameters() const;
 
