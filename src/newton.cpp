@@ -17,6 +17,7 @@
 #include <Thyra_TpetraThyraWrappers.hpp>
 
 #include <cstdio>
+#include <cstdlib>
 
 #include "errors.hpp"
 
@@ -203,6 +204,27 @@ class History : public NOX::Observer {
 // The six rigid-body modes of the body at its reference positions (about its
 // centroid): the near-null space that smoothed aggregation needs for
 // elasticity.
+// A point per 3 owned unknowns, as MueLu groups them (number of equations 3),
+// for its repartitioning: the owned nodes' reference coordinates, then (rank
+// 0) two points per rigid core at its axis point, for its 6 unknowns.
+RCP<Tpetra::MultiVector<>> unknownCoordinates(const Assembly& assembly) {
+  const Mesh& mesh = assembly.mesh();
+  const size_t n = assembly.dofMap()->getNodeNumElements() / 3;
+  std::vector<GO> gids(n);
+  for (size_t k = 0; k < n; ++k) gids[k] = assembly.dofMap()->getGlobalElement(LO(3 * k)) / 3;
+  const auto invalid = Teuchos::OrdinalTraits<Tpetra::global_size_t>::invalid();
+  auto map = rcp(new Map(invalid, Teuchos::ArrayView<const GO>(gids), 0, mesh.comm));
+  auto coords = rcp(new Tpetra::MultiVector<>(map, 3));
+  for (size_t k = 0; k < mesh.numOwnedNodes; ++k)
+    for (int i = 0; i < 3; ++i) coords->replaceLocalValue(LO(k), i, mesh.X[3 * k + i]);
+  const auto& cores = assembly.rigidCores();
+  for (size_t k = mesh.numOwnedNodes; k < n; ++k) {
+    const auto& core = cores[(k - mesh.numOwnedNodes) / 2];
+    for (int i = 0; i < 3; ++i) coords->replaceLocalValue(LO(k), i, core.axisPoint[i]);
+  }
+  return coords;
+}
+
 RCP<Tpetra::MultiVector<>> rigidBodyModes(const Assembly& assembly) {
   const Mesh& mesh = assembly.mesh();
   auto modes = rcp(new Tpetra::MultiVector<>(assembly.dofMap(), 6));
@@ -239,7 +261,8 @@ RCP<Tpetra::MultiVector<>> rigidBodyModes(const Assembly& assembly) {
 }
 
 Teuchos::ParameterList stratimikosParameters(const Teuchos::ParameterList& solver, long dofs, int ranks,
-                                             const RCP<Tpetra::MultiVector<>>& nullspace) {
+                                             const RCP<Tpetra::MultiVector<>>& nullspace,
+                                             const RCP<Tpetra::MultiVector<>>& coordinates) {
   Teuchos::ParameterList p("Stratimikos");
   std::string method = solver.get<std::string>("Linear Solver");
   // Auto: a sparse direct solve is fastest and immune to the penalty's
@@ -292,6 +315,18 @@ Teuchos::ParameterList stratimikosParameters(const Teuchos::ParameterList& solve
       }
       ml.set("coarse: max size", 1500);
       ml.set("Nullspace", nullspace);
+      // On several ranks the coarse levels (below 2000 unknowns per rank) move
+      // onto one rank, so that the coarsest solve is a serial KLU2: Amesos2's
+      // KLU2 on a distributed matrix solves wrongly in Trilinos 13.2, and a
+      // wrong coarse solve doubled MueLu's iterations (H1 4x without friction,
+      // 2 ranks: 450 Krylov iterations, 210 with this; 1 rank: 211).
+      if (ranks > 1) {
+        ml.set("repartition: enable", true);
+        ml.set("repartition: partitioner", "zoltan2");
+        ml.set("repartition: start level", 1);
+        ml.set("repartition: min rows per proc", 2000);
+        ml.set("Coordinates", coordinates);
+      }
     } else {
       p.set("Preconditioner Type", "Ifpack2");
       auto& ifp = p.sublist("Preconditioner Types").sublist("Ifpack2");
@@ -403,7 +438,8 @@ NewtonSolver::NewtonSolver(Assembly& assembly, const Teuchos::ParameterList& sol
                                        solver.get<std::string>("Preconditioner") != "ILU" &&
                                                solver.get<std::string>("Preconditioner") != "Jacobi"
                                            ? rigidBodyModes(assembly)
-                                           : Teuchos::null);
+                                           : Teuchos::null,
+                                       unknownCoordinates(assembly));
   // The scene's Stratimikos and NOX sublists are checked here, before the run
   // starts: Stratimikos validates its list, and building a NOX solver once
   // checks NOX's choices (solver, direction, line search names).
