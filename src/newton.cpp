@@ -17,7 +17,6 @@
 #include <Thyra_TpetraThyraWrappers.hpp>
 
 #include <cstdio>
-#include <cstdlib>
 
 #include "errors.hpp"
 
@@ -199,11 +198,6 @@ class History : public NOX::Observer {
   LagPolicy* lag_;
 };
 
-// capstan's solver knobs as Stratimikos parameters; the scene's Solver/Stratimikos
-// sublist is applied over them.
-// The six rigid-body modes of the body at its reference positions (about its
-// centroid): the near-null space that smoothed aggregation needs for
-// elasticity.
 // A point per 3 owned unknowns, as MueLu groups them (number of equations 3),
 // for its repartitioning: the owned nodes' reference coordinates, then (rank
 // 0) two points per rigid core at its axis point, for its 6 unknowns.
@@ -225,6 +219,9 @@ RCP<Tpetra::MultiVector<>> unknownCoordinates(const Assembly& assembly) {
   return coords;
 }
 
+// The six rigid-body modes of the body at its reference positions (about its
+// centroid): the near-null space that smoothed aggregation needs for
+// elasticity.
 RCP<Tpetra::MultiVector<>> rigidBodyModes(const Assembly& assembly) {
   const Mesh& mesh = assembly.mesh();
   auto modes = rcp(new Tpetra::MultiVector<>(assembly.dofMap(), 6));
@@ -260,6 +257,8 @@ RCP<Tpetra::MultiVector<>> rigidBodyModes(const Assembly& assembly) {
   return modes;
 }
 
+// capstan's solver knobs as Stratimikos parameters; the scene's Solver/Stratimikos
+// sublist is applied over them.
 Teuchos::ParameterList stratimikosParameters(const Teuchos::ParameterList& solver, long dofs, int ranks,
                                              const RCP<Tpetra::MultiVector<>>& nullspace,
                                              const RCP<Tpetra::MultiVector<>>& coordinates) {
