@@ -265,11 +265,12 @@ Teuchos::ParameterList stratimikosParameters(const Teuchos::ParameterList& solve
   Teuchos::ParameterList p("Stratimikos");
   std::string method = solver.get<std::string>("Linear Solver");
   // Auto: a sparse direct solve is fastest and immune to the penalty's
-  // conditioning on small meshes; Krylov with ILU above that size. On several
-  // ranks Amesos2 KLU2 fails on our FECrsMatrix in Trilinos 13.2 (a singular
-  // factorization of a matrix that GMRES solves), so Auto uses GMRES there.
-  if (method == "Auto")
-    method = dofs <= solver.get<int>("Direct Solver Max Dofs") && ranks == 1 ? "Direct" : "GMRES";
+  // conditioning on small meshes; Krylov with ILU above that size.
+  if (method == "Auto") method = dofs <= solver.get<int>("Direct Solver Max Dofs") ? "Direct" : "GMRES";
+  // Amesos2's KLU2 on several ranks solves our matrices wrongly in Trilinos
+  // 13.2 (Newton stalls: G1 and H1 ended with exit 2; first seen with a rigid
+  // core's rows, docs/pinch-roller.md): GMRES there, whatever the scene asked.
+  if (method == "Direct" && ranks > 1) method = "GMRES";
   if (method == "Direct") {
     p.set("Linear Solver Type", "Amesos2");
     p.set("Preconditioner Type", "None");
@@ -420,25 +421,17 @@ NewtonSolver::NewtonSolver(Assembly& assembly, const Teuchos::ParameterList& sol
   builder.setPreconditioningStrategyFactory(Teuchos::abstractFactoryStd<PrecBase, Ifpack2Factory>(),
                                             "Ifpack2");
   Stratimikos::enableMueLu(builder);
-  // Amesos2's KLU2 on several ranks solves our matrices wrongly in Trilinos
-  // 13.2 (Newton stalls: G1 and H1 end with exit 2; first seen with a rigid
-  // core's rows, docs/pinch-roller.md): there, Direct falls back to GMRES, and
-  // says so.
-  Teuchos::ParameterList chosen(solver);
   const int ranks = assembly.dofMap()->getComm()->getSize();
-  if (ranks > 1 && solver.get<std::string>("Linear Solver") == "Direct") {
-    chosen.set("Linear Solver", std::string("GMRES"));
-    if (assembly.dofMap()->getComm()->getRank() == 0)
-      std::fprintf(stderr, "capstan: note: Solver/Linear Solver = Direct is not reliable on %d ranks "
-                           "(Amesos2 KLU2 in Trilinos 13.2); using GMRES\n", ranks);
-  }
-  impl_->strat = stratimikosParameters(chosen, long(assembly.dofMap()->getGlobalNumElements()),
-                                       assembly.dofMap()->getComm()->getSize(),
+  const bool rank0 = assembly.dofMap()->getComm()->getRank() == 0;
+  if (ranks > 1 && solver.get<std::string>("Linear Solver") == "Direct" && rank0)  // (stratimikosParameters)
+    std::fprintf(stderr, "capstan: note: Solver/Linear Solver = Direct is not reliable on %d ranks "
+                         "(Amesos2 KLU2 in Trilinos 13.2); using GMRES\n", ranks);
+  impl_->strat = stratimikosParameters(solver, long(assembly.dofMap()->getGlobalNumElements()), ranks,
                                        solver.get<std::string>("Preconditioner") != "ILU" &&
                                                solver.get<std::string>("Preconditioner") != "Jacobi"
                                            ? rigidBodyModes(assembly)
                                            : Teuchos::null,
-                                       unknownCoordinates(assembly));
+                                       ranks > 1 ? unknownCoordinates(assembly) : Teuchos::null);
   // The scene's Stratimikos and NOX sublists are checked here, before the run
   // starts: Stratimikos validates its list, and building a NOX solver once
   // checks NOX's choices (solver, direction, line search names).

@@ -462,7 +462,8 @@ bool Run::solveAt(double t0, double t, StepRecord& rec, std::string& failure) {
     if (!opt_.quiet && rank0_ && std::getenv("CAPSTAN_NEWTON_LOG")) {
       std::printf("    newton |R|:");
       for (double n : r.residualHistory) std::printf(" %.3e", n);
-      std::printf("  (%d linear; preconditioners built: %d)\n", r.linearIterations, newton_->preconditionerBuilds());
+      std::printf("  (%d linear; preconditioners built: %d)\n", r.linearIterations,
+                  newton_->preconditionerBuilds());
     }
     // A later pass may start below what round-off lets Newton reach; a state
     // within the absolute tolerance is as converged as it gets.
