@@ -15,6 +15,7 @@ PressureStep::PressureStep(Assembly& assembly) : assembly_(assembly) {
   weight_ = rcp(new Vector(elementMap_));
   schurInverse_ = rcp(new Vector(elementMap_));
   scratch_ = rcp(new Vector(assembly_.dofMap()));
+  residualP_ = rcp(new Vector(elementMap_));
   // G^T's structure: each element's free dofs (a rigid core's unknowns for
   // its face nodes). Values come with each solve.
   Matrix ones("ones", ne, 24);
@@ -73,8 +74,21 @@ void PressureStep::applyPreconditioner(const Inverse& Kinv, const Block& r, Bloc
   Kinv(*scratch_, *z.u);
 }
 
+double PressureStep::volumeError(const Vector& rp) const {
+  const BrickEffect& bricks = assembly_.bricks();
+  auto V = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bricks.referenceVolume);
+  auto r = rp.getData();
+  auto w = weight_->getData();
+  double local = 0, global = 0;
+  for (size_t e = 0; e < V.extent(0); ++e)
+    if (w[e] > 0) local = std::max(local, std::fabs(r[e]) / (w[e] * V(e)));
+  Teuchos::reduceAll(*elementMap_->getComm(), Teuchos::REDUCE_MAX, local, Teuchos::outArg(global));
+  return global;
+}
+
 PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv, const Vector& f, double tolerance,
-                                         int maxIterations, Vector& dx, Kokkos::View<double*> dp) {
+                                         double volumeTarget, int maxIterations, Vector& dx,
+                                         Kokkos::View<double*> dp) {
   Kokkos::Timer timer;
   fillVolumeGradient();
   const BrickEffect& bricks = assembly_.bricks();
@@ -91,21 +105,30 @@ PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv
   Block x = newBlock(), work = newBlock(), z = newBlock();
   const double beta0 = std::sqrt(dot(rhs, rhs));
   Result result;
+  // Done: the volume error left meets the target, or the residual is reduced
+  // by `tolerance` and the volume error is far from the target anyway.
+  const auto done = [&](double res, double volumeLeft) {
+    if (volumeTarget <= 0) return res <= tolerance * beta0;
+    return volumeLeft <= volumeTarget || (res <= tolerance * beta0 && volumeLeft > 10 * volumeTarget);
+  };
+  double volumeLeft = volumeTarget > 0 ? volumeError(*rhs.p) : 0.0;
   const int m = std::max(1, std::min(maxIterations, 300));  // restart length
-  while (basis_.size() < size_t(m + 1)) basis_.push_back(newBlock());
+  if (basis_.empty()) basis_.push_back(newBlock());
   double beta = beta0;
   Block& r = work;
   update(1.0, rhs, 0.0, r);
-  while (beta > tolerance * beta0 && result.iterations < maxIterations) {
+  while (!done(beta, volumeLeft) && result.iterations < maxIterations) {
     // One GMRES(m) cycle from the residual r (Givens rotations on the
     // Hessenberg matrix H, modified Gram-Schmidt).
     std::vector<double> H((m + 1) * m, 0.0), cs(m), sn(m), s(m + 1, 0.0);
     auto h = [&](int i, int j) -> double& { return H[i * m + j]; };
     update(1 / beta, r, 0.0, basis_[0]);
+    residualP_->update(1.0, *basis_[0].p, 0.0);
     s[0] = beta;
     int k = 0;  // columns built
     double res = beta;
     while (k < m && result.iterations < maxIterations) {
+      if (basis_.size() < size_t(k + 2)) basis_.push_back(newBlock());  // allocated as the cycle needs
       applyPreconditioner(Kinv, basis_[k], z);
       Block& w = basis_[k + 1];
       applySystem(K, z, w);
@@ -126,8 +149,16 @@ PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv
       s[k + 1] = -sn[k] * s[k];
       s[k] = cs[k] * s[k];
       res = std::fabs(s[k + 1]);
+      // The volume error in GMRES's residual b - A x_k = s_{k+1} u_k, where
+      // u_k = V_{k+1} Q_k^T e_{k+1} (Q_k: the rotations so far) follows
+      // u_k = -sn_k u_{k-1} + cs_k v_{k+1}, u_{-1} = v_0: one update of its
+      // constraint block per iteration.
+      if (volumeTarget > 0) {
+        residualP_->update(cs[k], *basis_[k + 1].p, -sn[k]);
+        volumeLeft = std::fabs(s[k + 1]) * volumeError(*residualP_);
+      }
       ++k, ++result.iterations;
-      if (res <= tolerance * beta0 || b == 0) break;
+      if (done(res, volumeLeft) || b == 0) break;
     }
     // x += P^-1 (basis y), y = H^-1 s (upper triangular after the rotations)
     std::vector<double> y(k, 0.0);
@@ -146,9 +177,11 @@ PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv
     const double trueRes = std::sqrt(dot(r, r));
     const bool progress = trueRes < beta;
     beta = trueRes;
+    if (volumeTarget > 0) volumeLeft = volumeError(*r.p);
     if (!progress) break;  // stagnated: keep what there is (the loop checks the outcome)
   }
   result.reduction = beta0 > 0 ? beta / beta0 : 0.0;
+  result.volumeResidual = volumeError(*r.p);
   // Held dofs stay where they are (K's identity rows would keep them at ~0
   // anyway; the preconditioner need not).
   dx.update(1.0, *x.u, 0.0);

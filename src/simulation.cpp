@@ -36,6 +36,9 @@ double since(Clock::time_point t0) {
 // The saddle-point pressure step's GMRES tolerance (relative): the volume
 // error then falls about 1000x per pass in the linear regime.
 constexpr double kPressureStepTolerance = 1e-3;
+// ... and the volume error it aims to leave, as a fraction of the volume
+// tolerance: the pass it ends is then the last.
+constexpr double kPressureStepVolumeMargin = 0.3;
 
 MPI_Comm rawComm(const RCP<const Comm>& comm) {
   auto mpi = Teuchos::rcp_dynamic_cast<const Teuchos::MpiComm<int>>(comm);
@@ -184,7 +187,7 @@ class Run {
   // The pressure loop's saddle-point step at the converged state (src/
   // pressure_step.hpp): moves u and the pressure anchors together. False if
   // the block solve made no progress (nothing is changed then).
-  bool saddlePointPressureStep(double t, double volumeChange, Vector& f, StepRecord& rec);
+  bool saddlePointPressureStep(double t, Vector& f, StepRecord& rec);
   // Newton's linear solves and the pressure steps' block solves.
   double linearSolveSeconds() const {
     return newton_->linearSolveSeconds() + (pressureStep_ ? pressureStep_->seconds() : 0.0);
@@ -502,7 +505,7 @@ bool Run::solveAt(double t0, double t, StepRecord& rec, std::string& failure) {
       // volumes it makes exact.
       const std::vector<double> pressureNext = multiplierMap(true);  // at the converged state
       setMultipliers(multiplierMap(false), false, settled);
-      if (!volumeMet && !saddlePointPressureStep(t, rec.volumeChange, f, rec))  // no progress: a plain pass instead
+      if (!volumeMet && !saddlePointPressureStep(t, f, rec))  // no progress: a plain pass instead
         setMultipliers(pressureNext, true);
       continue;
     }
@@ -519,20 +522,19 @@ bool Run::solveAt(double t0, double t, StepRecord& rec, std::string& failure) {
   return false;
 }
 
-bool Run::saddlePointPressureStep(double t, double volumeChange, Vector& f, StepRecord& rec) {
+bool Run::saddlePointPressureStep(double t, Vector& f, StepRecord& rec) {
   BrickEffect& bricks = assembly_->bricks();
   auto W = newton_->matrix();
   assembly_->evaluate(*u_, &f, W.get());  // the tangent at the converged state
   Vector dx(assembly_->dofMap());
   Kokkos::View<double*> dp("pressure step dp", bricks.pressureAnchor.extent(0));
-  // Solved only as far as the volume tolerance needs (with a margin of 10),
-  // and at least to kPressureStepTolerance: the last passes of a step have
-  // only the hardest (nearly spurious) pressure modes left.
-  const double need = 0.1 * bricks.constraintTolerance() / volumeChange;
-  const double tolerance = std::min(0.1, std::max(kPressureStepTolerance, need));
+  // Solved until the volume error it leaves (to first order: it predicted the
+  // next pass's to a few per cent on G1) is a third of the volume tolerance, or
+  // to kPressureStepTolerance while that is still far off (PressureStep::solve).
+  const double tolerance = kPressureStepTolerance, volumeTarget = kPressureStepVolumeMargin * bricks.constraintTolerance();
   PressureStep::Result step;
   try {
-    step = pressureStep_->solve(*W, newton_->approximateInverse(), f, tolerance,
+    step = pressureStep_->solve(*W, newton_->approximateInverse(), f, tolerance, volumeTarget,
                                 scene_.solver.get<int>("Max Linear Iterations"), dx, dp);
   } catch (const std::exception&) {  // e.g. a preconditioner that cannot be built: a plain pass
     return false;
@@ -540,7 +542,8 @@ bool Run::saddlePointPressureStep(double t, double volumeChange, Vector& f, Step
   rec.linear += step.iterations;
   rec.pressureStep += step.iterations;
   if (!opt_.quiet && rank0_ && std::getenv("CAPSTAN_NEWTON_LOG"))
-    std::printf("    pressure step: %d GMRES iterations, residual reduced %.2e\n", step.iterations, step.reduction);
+    std::printf("    pressure step: %d GMRES iterations, residual reduced %.2e, volume error left %.2e\n",
+                step.iterations, step.reduction, step.volumeResidual);
   if (!(step.reduction < 1)) return false;
   u_->update(1.0, dx, 1.0);
   assembly_->applyConstraints(*u_, t);

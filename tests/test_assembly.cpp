@@ -115,7 +115,7 @@ TEST(PressureStep, SolvesTheMixedNewtonSystem) {
   Vector dx(assembly.dofMap());
   Kokkos::View<double*> dp("dp", bricks.pressureAnchor.extent(0));
   PressureStep step(assembly);
-  const auto result = step.solve(*W, newton.approximateInverse(), f, 1e-12, 500, dx, dp);
+  const auto result = step.solve(*W, newton.approximateInverse(), f, 1e-12, 0.0, 500, dx, dp);
   EXPECT_LT(result.reduction, 1e-11);
   const std::vector<double> dph = copy(dp);
   auto setAnchors = [&](double s) {
