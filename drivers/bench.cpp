@@ -12,7 +12,10 @@
 //     GFLOP/s and fraction of the FMA peak;
 //   - assembly: a plain global-index sumIntoGlobalValues loop (the element
 //     matrices already computed) against capstan's assembly (kernels, scatter
-//     at precomputed local offsets, export), elements/s.
+//     at precomputed local offsets, export), elements/s;
+//   - memory bandwidth (STREAM triad), rank 0 alone and all ranks at once:
+//     under `mpiexec -n 2` the ratio bounds how much a second rank can speed
+//     up the memory-bound sparse solves (docs/performance.md).
 #include <Kokkos_Timer.hpp>
 #include <Tpetra_Core.hpp>
 
@@ -89,6 +92,20 @@ constexpr double kBrickFlopsTangent =
 //   area elements 2 x 60, shape 30, position 24, gap 30, traction 10,
 //   residual 12 x 4, C 3x3 30, tangent 16 node pairs x 9 x 4  -> ~870
 constexpr double kContactFlops = 4 * 870;
+
+// STREAM triad a = b + s c over arrays far larger than the caches: bytes/s
+// moved (3 x 8 bytes per entry), for `seconds` from a common start.
+double triadBandwidth(long n, double seconds) {
+  Kokkos::View<double*> a("a", n), b("b", n), c("c", n);
+  Kokkos::deep_copy(b, 1.0), Kokkos::deep_copy(c, 2.0);
+  return rate(
+      [&] {
+        Kokkos::parallel_for(
+            "triad", Kokkos::RangePolicy<>(0, n), KOKKOS_LAMBDA(long i) { a(i) = b(i) + 1.5 * c(i); });
+        Kokkos::fence();
+      },
+      24.0 * n, seconds);
+}
 
 }  // namespace
 
@@ -187,6 +204,15 @@ int main(int argc, char** argv) {
       ne);
   const double ours = rate([&] { assembly.evaluate(u, &f, W.get()); }, ne);
 
+  // ---- memory bandwidth: rank 0 alone (the others wait), then all at once
+  const long streamLength = 20000000;  // 3 x 160 MB per rank
+  double alone = 0, together = 0;
+  comm->barrier();
+  if (comm->getRank() == 0) alone = triadBandwidth(streamLength, 1.0);
+  comm->barrier();
+  const double mine = triadBandwidth(streamLength, 1.0);
+  Teuchos::reduceAll(*comm, Teuchos::REDUCE_SUM, mine, Teuchos::outArg(together));
+
   if (comm->getRank() == 0) {
     auto row = [&](const char* what, double evals, double flops) {
       std::printf("| %s | %.3e | %.0f | %.2f | %.1f%% |\n", what, evals, flops, evals * flops * 1e-9,
@@ -200,7 +226,10 @@ int main(int argc, char** argv) {
     std::printf("| friction face, Coulomb sliding, 2x2 Gauss | %.3e | | | |\n\n", friction);
     std::printf("| assembly of residual + tangent | elements/s | ratio |\n|---|---|---|\n");
     std::printf("| plain sumIntoGlobalValues loop (insertion only) | %.3e | 1 |\n", plainGlobal);
-    std::printf("| capstan (kernels + local scatter + export) | %.3e | %.1f |\n", ours, ours / plainGlobal);
+    std::printf("| capstan (kernels + local scatter + export) | %.3e | %.1f |\n\n", ours, ours / plainGlobal);
+    std::printf("| memory bandwidth (triad) | GB/s | ratio |\n|---|---|---|\n");
+    std::printf("| rank 0 alone | %.1f | 1 |\n", alone * 1e-9);
+    std::printf("| all %d ranks at once (sum) | %.1f | %.2f |\n", comm->getSize(), together * 1e-9, together / alone);
     if (sink == 42.0) std::printf("(unlikely)\n");
   }
   return 0;
