@@ -106,10 +106,15 @@ PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv
   const double beta0 = std::sqrt(dot(rhs, rhs));
   Result result;
   // Done: the volume error left meets the target, or the residual is reduced
-  // by `tolerance` and the volume error is far from the target anyway.
+  // by `tolerance` and the volume error is far from the target anyway. Going
+  // on past `tolerance` is worth at most as many iterations again (+10): a
+  // target below what round-off allows must not run to maxIterations.
+  int reachedAt = -1;  // iterations when the residual first met `tolerance`
   const auto done = [&](double res, double volumeLeft) {
-    if (volumeTarget <= 0) return res <= tolerance * beta0;
-    return volumeLeft <= volumeTarget || (res <= tolerance * beta0 && volumeLeft > 10 * volumeTarget);
+    if (res > tolerance * beta0) return volumeTarget > 0 && volumeLeft <= volumeTarget;
+    if (reachedAt < 0) reachedAt = result.iterations;
+    return volumeTarget <= 0 || volumeLeft <= volumeTarget || volumeLeft > 10 * volumeTarget ||
+           result.iterations >= 2 * reachedAt + 10;
   };
   double volumeLeft = volumeTarget > 0 ? volumeError(*rhs.p) : 0.0;
   const int m = std::max(1, std::min(maxIterations, 300));  // restart length

@@ -54,9 +54,9 @@ class PressureStep {
   // most volumeTarget: then this pass meets the volume tolerance. Failing
   // that, at the residual reduction `tolerance`, if the volume error left is
   // still above 10 volumeTarget (the next pass, quadratically closer, finishes
-  // the job); close to the target it goes on, since a pass (a Newton solve
-  // and a pressure step) costs more than the iterations that remain.
-  // volumeTarget 0: the reduction alone.
+  // the job); close to the target it goes on (for at most as many iterations
+  // again), since a pass (a Newton solve and a pressure step) costs more than
+  // the iterations that remain. volumeTarget 0: the reduction alone.
   Result solve(const CrsMatrix& K, const Inverse& Kinv, const Vector& f, double tolerance, double volumeTarget,
                int maxIterations, Vector& dx, Kokkos::View<double*> dp);
   double seconds() const { return seconds_; }
