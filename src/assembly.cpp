@@ -346,13 +346,14 @@ void Assembly::findEntryOffsets() {
 RCP<FEMatrix> Assembly::createMatrix() const { return rcp(new FEMatrix(graph_)); }
 
 void Assembly::chainRows(const Effect& e, const Matrix& values, std::vector<size_t>& rowStart,
-                         std::vector<GO>& cols, std::vector<double>& vals) const {
+                         std::vector<GO>& cols, std::vector<double>& vals, const std::vector<int>* entities) const {
   auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), e.local().dofs);
   auto v = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), values);
   const auto& supportOf = constraints_.supportOf;
   auto gid = [&](int dof) { return overlapDofMap_->getGlobalElement(overlapLid(dof)); };
   rowStart.assign(1, 0), cols.clear(), vals.clear();
-  for (size_t k = 0; k < dofs.extent(0); ++k) {
+  for (size_t k = 0; k < v.extent(0); ++k) {
+    const size_t entity = entities ? size_t((*entities)[k]) : k;
     const size_t first = cols.size();
     auto add = [&](GO col, double x) {
       for (size_t i = first; i < cols.size(); ++i)
@@ -360,7 +361,7 @@ void Assembly::chainRows(const Effect& e, const Matrix& values, std::vector<size
       cols.push_back(col), vals.push_back(x);
     };
     for (size_t j = 0; j < dofs.extent(1); ++j) {
-      const int d = dofs(k, j), c = coreOfNode_[d / 3];
+      const int d = dofs(entity, j), c = coreOfNode_[d / 3];
       if (c < 0) {
         if (supportOf[d] < 0) add(gid(d), v(k, j));
         continue;

@@ -121,8 +121,9 @@ class Assembly {
   // face-node entries go to the core's free unknowns (the translations, and
   // the rotation through du/dtheta at the last evaluation); held dofs drop.
   // Row r is cols/vals[rowStart[r] .. rowStart[r + 1]), each column once.
+  // entities: row r's entity, if not one row per entity in order.
   void chainRows(const Effect& e, const Matrix& values, std::vector<size_t>& rowStart, std::vector<GO>& cols,
-                 std::vector<double>& vals) const;
+                 std::vector<double>& vals, const std::vector<int>* entities = nullptr) const;
 
   // Reaction force of each constrained support on the body, from the last
   // evaluation (global sum).

@@ -131,6 +131,18 @@ void BrickEffect::volumeGradients(const NodalVectors& x, Matrix& g) const {
       });
 }
 
+void BrickEffect::constraintRows(const NodalVectors& x, ConstraintRows& rows) const {
+  volumeGradients(x, rows.gradient);
+  auto v = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), volume);
+  auto V = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), referenceVolume);
+  rows.clear();
+  for (size_t e = 0; e < V.extent(0); ++e) {
+    rows.entity.push_back(int(e)), rows.multiplier.push_back(int(e));
+    rows.force.push_back(-1.0), rows.diagonal.push_back(0.0), rows.value.push_back(v(e) - V(e));
+    rows.schur.push_back(penalty_ * V(e)), rows.scale.push_back(V(e));
+  }
+}
+
 void BrickEffect::multiplierMap(const Kokkos::View<double*>& next) const {
   Kokkos::deep_copy(next, pressure);
 }
@@ -361,6 +373,39 @@ void ContactEffect::projectMultipliers() {
   Kokkos::parallel_for(
       "contact multiplier projection", Kokkos::RangePolicy<ExecSpace>(0, lambda.extent(0)),
       KOKKOS_LAMBDA(int i) { lambda(i) = lambda(i) > 0 ? lambda(i) : 0.0; });
+}
+
+void ContactEffect::constraintRows(const NodalVectors&, ConstraintRows& rows) const {
+  rows.clear();
+  if (!augmented() || settings_.smoothing > 0) {
+    rows.gradient = Matrix();
+    return;
+  }
+  // On the host: a few thousand candidate faces at most, most not in contact.
+  auto pts = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), points_);
+  auto lambda = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), lambda_);
+  const auto rule = kernels::FaceRule(settings_.rule);
+  const int nq = kernels::facePointCount(rule);
+  const double eps = solvePenalty_, kappa = compliance_;
+  std::vector<double> grad;
+  for (size_t f = 0; f < pts.extent(0); ++f)
+    for (int q = 0; q < nq; ++q) {
+      if (!(pts(f, q, kPressure) > 0)) continue;
+      const int m = int(f) * kernels::kMaxFacePoints + q;
+      double xi, eta, w, N[4], dN[4][2];
+      kernels::facePoint(rule, q, xi, eta, w);
+      kernels::quadShape(xi, eta, N, dN);
+      for (int a = 0; a < 4; ++a)
+        for (int i = 0; i < 3; ++i) grad.push_back(-N[a] * pts(f, q, kE + i));  // d g / d x_a
+      rows.entity.push_back(int(f)), rows.multiplier.push_back(m);
+      rows.force.push_back(pts(f, q, kWeight) * (1 - kappa / eps)), rows.diagonal.push_back(-kappa);
+      rows.value.push_back(pts(f, q, kGap) - kappa * lambda(m));
+      rows.schur.push_back(-eps), rows.scale.push_back(0.0);
+    }
+  rows.gradient = Matrix("contact dg/dx", rows.size(), 12);
+  auto h = Kokkos::create_mirror_view(rows.gradient);
+  for (size_t k = 0; k < grad.size(); ++k) h.data()[k] = grad[k];
+  Kokkos::deep_copy(rows.gradient, h);
 }
 
 // eps |t_n - lambda|: the penetration |g| at points in contact (exact contact),

@@ -34,6 +34,26 @@ struct LocalSystem {
   Kokkos::View<int*> active;
 };
 
+// An effect's constraints, linearised at the last evaluation, for the
+// saddle-point step (src/pressure_step.hpp), which solves for the position
+// change and the multipliers' changes together. Row j, multiplier mu_j:
+//     c_j(x + dx, mu_j + dmu_j) ~ c_j + gradient_j . dx + diagonal_j dmu_j = 0,
+//     dR / dmu_j = force_j gradient_j,
+// and schur_j approximates the Schur complement's diagonal
+// diagonal_j - force_j gradient_j^T K^-1 gradient_j: Newton's K holds each
+// constraint's penalty, which makes that diagonal approximation good.
+struct ConstraintRows {
+  std::vector<int> entity;      // row j's entity (its dofs: local().dofs(entity_j, .))
+  std::vector<int> multiplier;  // mu_j's index in multipliers()
+  Matrix gradient;              // [j][k]: d c_j / d x over the entity's dofs
+  std::vector<double> force, diagonal, value, schur;
+  // c_j's unit for the step's stop rule (|c_j| / scale_j against a relative
+  // tolerance), or 0: the stop rule does not look at row j.
+  std::vector<double> scale;
+  size_t size() const { return entity.size(); }
+  void clear() { entity.clear(), multiplier.clear(), force.clear(), diagonal.clear(), value.clear(), schur.clear(), scale.clear(); }
+};
+
 class Effect {
  public:
   explicit Effect(std::string name) : name_(std::move(name)) {}
@@ -71,6 +91,9 @@ class Effect {
   virtual bool accelerated() const { return true; }
   // Brings mixed multipliers back into their admissible set (e.g. lambda >= 0).
   virtual void projectMultipliers() {}
+  // This rank's rows for the saddle-point step, at positions x (the last
+  // evaluation's); none by default (a plain multiplier update).
+  virtual void constraintRows(const NodalVectors& /*x*/, ConstraintRows& rows) const { rows.clear(); }
   // Largest violation of the constraint on this rank at the last evaluation,
   // and the tolerance it must meet (same units).
   virtual double constraintViolation() const { return 0; }
@@ -104,6 +127,9 @@ class BrickEffect : public Effect {
   double solvePenalty() const { return penalty_; }
   // d v_e / d x at positions x (overlapped nodes), 24 per element (dof 3a+i).
   void volumeGradients(const NodalVectors& x, Matrix& g) const;
+  // c_e = v_e - V_e with the anchor pbar_e: force -1 (dR/dpbar = -g_e),
+  // Schur complement eps V_e, every element a row.
+  void constraintRows(const NodalVectors& x, ConstraintRows& rows) const override;
 
   // Pressure anchors: G(pbar) = p(x); violation max |v/V - 1|.
   Kokkos::View<double*> multipliers() override { return pressureAnchor; }
@@ -193,6 +219,11 @@ class ContactEffect : public Effect {
   // max(0, .) where points enter or leave contact made the loop wander.
   bool accelerated() const override { return false; }
   double constraintViolation() const override;
+  // Exact contact's points in contact (t_n > 0; the augmented Lagrangian
+  // without a smoothed corner): c_q = g_q - kappa lambda_q, gradient -N_a e,
+  // force w (1 - kappa / eps) (w: reference area weight), Schur complement
+  // -eps. Other points keep the plain update.
+  void constraintRows(const NodalVectors& x, ConstraintRows& rows) const override;
   double constraintTolerance() const override { return settings_.tolerance; }
   std::string constraintName() const override { return name() + " penetration"; }
   int maxAugmentations() const { return settings_.maxAugmentations; }

@@ -6,105 +6,140 @@
 
 namespace capstan {
 
-PressureStep::PressureStep(Assembly& assembly) : assembly_(assembly) {
-  const BrickEffect& bricks = assembly_.bricks();
-  const size_t ne = bricks.pressureAnchor.extent(0);
-  auto comm = assembly_.dofMap()->getComm();
-  elementMap_ = rcp(new Map(Tpetra::global_size_t(Teuchos::OrdinalTraits<Tpetra::global_size_t>::invalid()), ne,
-                            GO(0), comm));
-  weight_ = rcp(new Vector(elementMap_));
-  schurInverse_ = rcp(new Vector(elementMap_));
+PressureStep::PressureStep(Assembly& assembly)
+    : assembly_(assembly), effectRows_(assembly.effects().size()) {
   scratch_ = rcp(new Vector(assembly_.dofMap()));
-  residualP_ = rcp(new Vector(elementMap_));
-  // G^T's structure: each element's free dofs (a rigid core's unknowns for
-  // its face nodes). Values come with each solve.
-  Matrix ones("ones", ne, 24);
-  Kokkos::deep_copy(ones, 1.0);
-  assembly_.chainRows(bricks, ones, rowStart_, cols_, vals_);
-  size_t longest = 1;
-  for (size_t e = 0; e < ne; ++e) longest = std::max(longest, rowStart_[e + 1] - rowStart_[e]);
-  gradient_ = rcp(new CrsMatrix(elementMap_, longest));
-  for (size_t e = 0; e < ne; ++e)
-    if (rowStart_[e + 1] > rowStart_[e])
-      gradient_->insertGlobalValues(elementMap_->getGlobalElement(LO(e)), row(cols_, e), row(vals_, e));
-  gradient_->fillComplete(assembly_.dofMap(), elementMap_);
 }
 
 PressureStep::Block PressureStep::newBlock() const {
-  return {rcp(new Vector(assembly_.dofMap())), rcp(new Vector(elementMap_))};
+  return {rcp(new Vector(assembly_.dofMap())), rcp(new Vector(rowMap_))};
 }
 
-void PressureStep::fillVolumeGradient() {
-  const BrickEffect& bricks = assembly_.bricks();
-  bricks.volumeGradients(assembly_.positions(), g_);
-  assembly_.chainRows(bricks, g_, rowStart_, cols_, vals_);
-  auto g = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), g_);
-  auto V = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bricks.referenceVolume);
-  const double eps = bricks.solvePenalty();
-  auto w = weight_->getDataNonConst();
-  auto sInv = schurInverse_->getDataNonConst();
-  gradient_->resumeFill();
-  for (size_t e = 0; e < g.extent(0); ++e) {
-    double norm2 = 0;
-    for (int k = 0; k < 24; ++k) norm2 += g(e, k) * g(e, k);
-    // An element with no free dof (all its nodes held) has no constraint row:
-    // weight 0 keeps its equation and its dp at 0.
-    const bool empty = rowStart_[e + 1] == rowStart_[e];
-    w[e] = empty ? 0.0 : std::sqrt(norm2) / (eps * V(e));
-    sInv[e] = empty ? 0.0 : 1 / (w[e] * eps * V(e));
-    if (!empty) gradient_->replaceGlobalValues(elementMap_->getGlobalElement(LO(e)), row(cols_, e), row(vals_, e));
+void PressureStep::fillRows() {
+  const auto& effects = assembly_.effects();
+  size_t local = 0;
+  for (size_t i = 0; i < effects.size(); ++i) {
+    effects[i]->constraintRows(assembly_.positions(), effectRows_[i]);
+    local += effectRows_[i].size();
   }
-  gradient_->fillComplete(assembly_.dofMap(), elementMap_);
+  // A new map (and Krylov basis) only when some rank's row count changed.
+  auto comm = assembly_.dofMap()->getComm();
+  int changed = rowMap_.is_null() || rowMap_->getNodeNumElements() != local, anyChanged = 0;
+  Teuchos::reduceAll(*comm, Teuchos::REDUCE_MAX, changed, Teuchos::outArg(anyChanged));
+  if (anyChanged) {
+    rowMap_ = rcp(new Map(Tpetra::global_size_t(Teuchos::OrdinalTraits<Tpetra::global_size_t>::invalid()), local,
+                          GO(0), comm));
+    for (auto* v : {&weight_, &force_, &diagonal_, &schurInverse_, &volumeScale_, &scratchC_, &residualC_})
+      *v = rcp(new Vector(rowMap_));
+    basis_.clear();
+    lastRowStart_.clear();
+  }
+  rows_ = long(rowMap_->getGlobalNumElements());
+  // B^T's rows and the row vectors, effect after effect.
+  rowStart_.assign(1, 0), cols_.clear(), vals_.clear();
+  auto w = weight_->getDataNonConst();
+  auto F = force_->getDataNonConst();
+  auto D = diagonal_->getDataNonConst();
+  auto sInv = schurInverse_->getDataNonConst();
+  auto vs = volumeScale_->getDataNonConst();
+  std::vector<size_t> start;
+  std::vector<GO> cols;
+  std::vector<double> vals;
+  size_t j = 0;
+  for (size_t i = 0; i < effects.size(); ++i) {
+    const ConstraintRows& r = effectRows_[i];
+    if (r.size() == 0) continue;
+    assembly_.chainRows(*effects[i], r.gradient, start, cols, vals, &r.entity);
+    auto grad = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), r.gradient);
+    for (size_t k = 0; k < r.size(); ++k, ++j) {
+      double norm2 = 0;
+      for (size_t l = 0; l < grad.extent(1); ++l) norm2 += grad(k, l) * grad(k, l);
+      // A row with no free dof (all its nodes held) is no constraint: weight 0
+      // keeps its equation and its dmu at 0.
+      const bool empty = start[k + 1] == start[k];
+      w[j] = empty ? 0.0 : std::fabs(r.force[k]) * std::sqrt(norm2) / std::fabs(r.schur[k]);
+      sInv[j] = empty ? 0.0 : 1 / (w[j] * r.schur[k]);
+      F[j] = r.force[k], D[j] = r.diagonal[k];
+      vs[j] = empty ? 0.0 : w[j] * r.scale[k];
+      cols_.insert(cols_.end(), cols.begin() + long(start[k]), cols.begin() + long(start[k + 1]));
+      vals_.insert(vals_.end(), vals.begin() + long(start[k]), vals.begin() + long(start[k + 1]));
+      rowStart_.push_back(cols_.size());
+    }
+  }
+  // Refilled in place while the pattern holds (no contact point came or went).
+  const bool same = !lastRowStart_.empty() && rowStart_ == lastRowStart_ && cols_ == lastCols_;
+  if (same) {
+    gradient_->resumeFill();
+  } else {
+    size_t longest = 1;
+    for (size_t k = 0; k + 1 < rowStart_.size(); ++k) longest = std::max(longest, rowStart_[k + 1] - rowStart_[k]);
+    gradient_ = rcp(new CrsMatrix(rowMap_, longest));
+    lastRowStart_ = rowStart_, lastCols_ = cols_;
+  }
+  for (size_t k = 0; k + 1 < rowStart_.size(); ++k) {
+    if (rowStart_[k + 1] == rowStart_[k]) continue;
+    const GO gid = rowMap_->getGlobalElement(LO(k));
+    if (same)
+      gradient_->replaceGlobalValues(gid, row(cols_, k), row(vals_, k));
+    else
+      gradient_->insertGlobalValues(gid, row(cols_, k), row(vals_, k));
+  }
+  gradient_->fillComplete(assembly_.dofMap(), rowMap_);
 }
 
 void PressureStep::applySystem(const CrsMatrix& K, const Block& x, Block& y) const {
-  // y_u = K x_u - G x_p
+  // y_u = K x_u + B F x_c
   K.apply(*x.u, *y.u);
-  gradient_->apply(*x.p, *y.u, Teuchos::TRANS, -1.0, 1.0);
-  // y_p = w .* (G^T x_u)
-  gradient_->apply(*x.u, *y.p);
-  y.p->elementWiseMultiply(1.0, *weight_, *y.p, 0.0);
+  scratchC_->elementWiseMultiply(1.0, *force_, *x.c, 0.0);
+  gradient_->apply(*scratchC_, *y.u, Teuchos::TRANS, 1.0, 1.0);
+  // y_c = w .* (B^T x_u + D x_c)
+  gradient_->apply(*x.u, *y.c);
+  y.c->elementWiseMultiply(1.0, *diagonal_, *x.c, 1.0);
+  y.c->elementWiseMultiply(1.0, *weight_, *y.c, 0.0);
 }
 
 void PressureStep::applyPreconditioner(const Inverse& Kinv, const Block& r, Block& z) {
-  // z_p = (w eps M)^-1 r_p, then z_u = K~^-1 (r_u + G z_p)
-  z.p->elementWiseMultiply(1.0, *schurInverse_, *r.p, 0.0);
+  // z_c = (w S)^-1 r_c, then z_u = K~^-1 (r_u - B F z_c)
+  z.c->elementWiseMultiply(1.0, *schurInverse_, *r.c, 0.0);
+  scratchC_->elementWiseMultiply(1.0, *force_, *z.c, 0.0);
   scratch_->update(1.0, *r.u, 0.0);
-  gradient_->apply(*z.p, *scratch_, Teuchos::TRANS, 1.0, 1.0);
+  gradient_->apply(*scratchC_, *scratch_, Teuchos::TRANS, -1.0, 1.0);
   Kinv(*scratch_, *z.u);
 }
 
-double PressureStep::volumeError(const Vector& rp) const {
-  const BrickEffect& bricks = assembly_.bricks();
-  auto V = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bricks.referenceVolume);
-  auto r = rp.getData();
-  auto w = weight_->getData();
+double PressureStep::volumeError(const Vector& rc) const {
+  auto r = rc.getData();
+  auto s = volumeScale_->getData();
   double local = 0, global = 0;
-  for (size_t e = 0; e < V.extent(0); ++e)
-    if (w[e] > 0) local = std::max(local, std::fabs(r[e]) / (w[e] * V(e)));
-  Teuchos::reduceAll(*elementMap_->getComm(), Teuchos::REDUCE_MAX, local, Teuchos::outArg(global));
+  for (size_t j = 0; j < size_t(r.size()); ++j)
+    if (s[j] > 0) local = std::max(local, std::fabs(r[j]) / s[j]);
+  Teuchos::reduceAll(*rowMap_->getComm(), Teuchos::REDUCE_MAX, local, Teuchos::outArg(global));
   return global;
 }
 
 PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv, const Vector& f, double tolerance,
                                          double volumeTarget, int maxIterations, Vector& dx,
-                                         Kokkos::View<double*> dp) {
+                                         std::vector<Kokkos::View<double*>>& dmu) {
   Kokkos::Timer timer;
-  fillVolumeGradient();
-  const BrickEffect& bricks = assembly_.bricks();
-  // Right-hand side: (-R, w .* (V - v)).
+  fillRows();
+  Result result;
+  // Right-hand side: (-R, -w .* c).
   Block rhs = newBlock();
   rhs.u->update(-1.0, f, 0.0);
   {
-    auto v = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bricks.volume);
-    auto V = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bricks.referenceVolume);
-    auto r = rhs.p->getDataNonConst();
+    auto r = rhs.c->getDataNonConst();
     auto w = weight_->getData();
-    for (size_t e = 0; e < v.extent(0); ++e) r[e] = w[e] * (V(e) - v(e));
+    size_t j = 0;
+    for (size_t i = 0; i < effectRows_.size(); ++i)
+      for (size_t k = 0; k < effectRows_[i].size(); ++k, ++j) r[j] = -w[j] * effectRows_[i].value[k];
+    long contact = 0, all = 0;
+    for (size_t i = 0; i < effectRows_.size(); ++i)
+      if (assembly_.effects()[i].get() != &assembly_.bricks()) contact += long(effectRows_[i].size());
+    Teuchos::reduceAll(*rowMap_->getComm(), Teuchos::REDUCE_SUM, contact, Teuchos::outArg(all));
+    result.contactRows = int(all);
   }
   Block x = newBlock(), work = newBlock(), z = newBlock();
   const double beta0 = std::sqrt(dot(rhs, rhs));
-  Result result;
   // Done: the volume error left meets the target, or the residual is reduced
   // by `tolerance` and the volume error is far from the target anyway. Going
   // on past `tolerance` is worth at most as many iterations again (+10): a
@@ -116,7 +151,7 @@ PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv
     return volumeTarget <= 0 || volumeLeft <= volumeTarget || volumeLeft > 10 * volumeTarget ||
            result.iterations >= 2 * reachedAt + 10;
   };
-  double volumeLeft = volumeTarget > 0 ? volumeError(*rhs.p) : 0.0;
+  double volumeLeft = volumeTarget > 0 ? volumeError(*rhs.c) : 0.0;
   const int m = std::max(1, std::min(maxIterations, 300));  // restart length
   if (basis_.empty()) basis_.push_back(newBlock());
   double beta = beta0;
@@ -128,7 +163,7 @@ PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv
     std::vector<double> H((m + 1) * m, 0.0), cs(m), sn(m), s(m + 1, 0.0);
     auto h = [&](int i, int j) -> double& { return H[i * m + j]; };
     update(1 / beta, r, 0.0, basis_[0]);
-    residualP_->update(1.0, *basis_[0].p, 0.0);
+    residualC_->update(1.0, *basis_[0].c, 0.0);
     s[0] = beta;
     int k = 0;  // columns built
     double res = beta;
@@ -159,8 +194,8 @@ PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv
       // u_k = -sn_k u_{k-1} + cs_k v_{k+1}, u_{-1} = v_0: one update of its
       // constraint block per iteration.
       if (volumeTarget > 0) {
-        residualP_->update(cs[k], *basis_[k + 1].p, -sn[k]);
-        volumeLeft = std::fabs(s[k + 1]) * volumeError(*residualP_);
+        residualC_->update(cs[k], *basis_[k + 1].c, -sn[k]);
+        volumeLeft = std::fabs(s[k + 1]) * volumeError(*residualC_);
       }
       ++k, ++result.iterations;
       if (done(res, volumeLeft) || b == 0) break;
@@ -172,7 +207,7 @@ PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv
       for (int j = i + 1; j < k; ++j) t -= h(i, j) * y[j];
       y[i] = h(i, i) != 0 ? t / h(i, i) : 0.0;
     }
-    r.u->putScalar(0.0), r.p->putScalar(0.0);
+    r.u->putScalar(0.0), r.c->putScalar(0.0);
     for (int i = 0; i < k; ++i) update(y[i], basis_[i], 1.0, r);
     applyPreconditioner(Kinv, r, z);
     update(1.0, z, 1.0, x);
@@ -182,11 +217,11 @@ PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv
     const double trueRes = std::sqrt(dot(r, r));
     const bool progress = trueRes < beta;
     beta = trueRes;
-    if (volumeTarget > 0) volumeLeft = volumeError(*r.p);
+    if (volumeTarget > 0) volumeLeft = volumeError(*r.c);
     if (!progress) break;  // stagnated: keep what there is (the loop checks the outcome)
   }
   result.reduction = beta0 > 0 ? beta / beta0 : 0.0;
-  result.volumeResidual = volumeError(*r.p);
+  result.volumeResidual = volumeError(*r.c);
   // Held dofs stay where they are (K's identity rows would keep them at ~0
   // anyway; the preconditioner need not).
   dx.update(1.0, *x.u, 0.0);
@@ -195,10 +230,19 @@ PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv
     for (LO i = 0; i < LO(dx.getLocalLength()); ++i)
       if (assembly_.ownedConstrained(i)) d[i] = 0;
   }
-  auto hp = Kokkos::create_mirror_view(dp);
-  auto xp = x.p->getData();
-  for (size_t e = 0; e < hp.extent(0); ++e) hp(e) = xp[e];
-  Kokkos::deep_copy(dp, hp);
+  // dmu into each effect's multiplier layout.
+  auto xc = x.c->getData();
+  dmu.resize(effectRows_.size());
+  size_t j = 0;
+  for (size_t i = 0; i < effectRows_.size(); ++i) {
+    auto mu = assembly_.effects()[i]->multipliers();
+    if (dmu[i].extent(0) != mu.extent(0)) dmu[i] = Kokkos::View<double*>("pressure step dmu", mu.extent(0));
+    auto h = Kokkos::create_mirror_view(dmu[i]);
+    Kokkos::deep_copy(h, 0.0);
+    const ConstraintRows& r = effectRows_[i];
+    for (size_t k = 0; k < r.size(); ++k, ++j) h(r.multiplier[k]) = xc[j];
+    Kokkos::deep_copy(dmu[i], h);
+  }
   seconds_ += timer.seconds();
   return result;
 }

@@ -1,33 +1,38 @@
 // The saddle-point pressure step: how the pressure loop moves the element
-// pressure anchors (Solver/Pressure Update = Saddle Point; docs/numerics.md).
+// pressure anchors, and exact contact's multipliers with them (Solver/Pressure
+// Update = Saddle Point; docs/numerics.md).
 //
-// Newton converges with the anchors pbar held. The plain update pbar <- p(x)
+// Newton converges with the multipliers held. The plain update pbar <- p(x)
 // (Uzawa) shrinks each pressure mode's error by 1/(1 + lambda/eps), lambda its
 // eigenvalue of the Schur complement; Q1P0's nearly spurious modes have
 // lambda ~ h^2, so the finer the mesh, the more passes (G1: 45, 76, 228 per
 // run on 1x, 2x, 4x, even with Anderson mixing), each a Newton solve. This
-// step instead solves for the position change dx and the anchor change dp
-// together, so that equilibrium holds and every element's volume is exact to
-// first order:
+// step instead solves for the position change dx and the multipliers' changes
+// dmu together, so that equilibrium holds and every constraint is met to first
+// order (effects.hpp, ConstraintRows: the element volumes, c_e = v_e - V_e with
+// the anchors; exact contact's points in contact, c_q = g_q with lambda_q):
 //
-//     [ K     -G ] [dx]   [ -R    ]     K: Newton's tangent (penalty eps)
-//     [ G^T    0 ] [dp] = [ V - v ]     G: column e = g_e = d v_e / d x
+//     [ K     B F ] [dx ]   [ -R ]     K: Newton's tangent (the penalties)
+//     [ B^T   D   ] [dmu] = [ -c ]     B: column j = d c_j / d x, F = diag(dR/dmu_j / B_j)
 //
-// (R depends on pbar through -p g_e, so dR/dpbar = -G: a Newton step on the
-// mixed problem.) K already holds G (eps M)^-1 G^T, M = diag(V_e): this is the
-// augmented-Lagrangian form, whose pressure Schur complement G^T K^-1 G is
-// close to eps M on all but those nearly spurious modes. GMRES, right-
-// preconditioned by the block upper-triangular
+// (a Newton step on the mixed problem). Contact moves with the volumes: its
+// plain update alone gains ~30x a pass, and each of its changes moves the
+// volumes again (G1 2x: 6 passes a load step, set by contact).
+// K already holds each constraint's penalty (e.g. G (eps M)^-1 G^T, M =
+// diag(V_e)): this is the augmented-Lagrangian form, whose Schur complement
+// D - B^T K^-1 B F is close to its diagonal approximation S (eps V_e for a
+// volume, -eps for a contact point) on all but Q1P0's nearly spurious modes.
+// GMRES, right-preconditioned by the block upper-triangular
 //
-//     P = [ K~  -G ; 0  eps M ],   K~^-1: Newton's preconditioner,
+//     P = [ K~  B F ; 0  S ],   K~^-1: Newton's preconditioner,
 //
 // needs about the iterations of one Newton solve plus a few for those modes,
 // where the plain loop needs a Newton solve per pass.
 //
-// The constraint rows are scaled by w_e = |g_e| / (eps V_e): a volume error
-// then counts as the force it causes through the penalty, comparable with R.
-// G carries a rigid core's face-node entries to the core's free unknowns (as
-// the matrix assembly does); held dofs are left out.
+// Each constraint row is scaled by w_j = |F_j| |B_j| / |S_j|: a constraint
+// error then counts as the force it causes through the penalty, comparable
+// with R. B carries a rigid core's face-node entries to the core's free
+// unknowns (as the matrix assembly does); held dofs are left out.
 #pragma once
 
 #include <functional>
@@ -47,9 +52,10 @@ class PressureStep {
     int iterations = 0;
     double reduction = 1;  // final / initial residual (both blocks, scaled)
     double volumeResidual = 0;  // max_e |V_e - v_e - g_e.dx| / V_e: the volume error the step leaves (to first order)
+    int contactRows = 0;        // contact points in the step (all ranks)
   };
-  // At the last evaluation (f its residual, K its tangent, the bricks' volumes
-  // and positions): dx (owned dofs, zero on held ones) and dp (per element).
+  // At the last evaluation (f its residual, K its tangent, the effects' states
+  // and the positions): dx (owned dofs, zero on held ones) and dmu.
   // GMRES stops once the volume error the step leaves (max_e, relative) is at
   // most volumeTarget: then this pass meets the volume tolerance. Failing
   // that, at the residual reduction `tolerance`, if the volume error left is
@@ -57,44 +63,55 @@ class PressureStep {
   // the job); close to the target it goes on (for at most as many iterations
   // again), since a pass (a Newton solve and a pressure step) costs more than
   // the iterations that remain. volumeTarget 0: the reduction alone.
+  // dmu: every effect's multiplier changes, in its multipliers() layout
+  // (zero where it has no row; empty views for effects without multipliers).
   Result solve(const CrsMatrix& K, const Inverse& Kinv, const Vector& f, double tolerance, double volumeTarget,
-               int maxIterations, Vector& dx, Kokkos::View<double*> dp);
+               int maxIterations, Vector& dx, std::vector<Kokkos::View<double*>>& dmu);
+  // Constraint rows of the last solve (all ranks): volumes and contact points.
+  long rows() const { return rows_; }
   double seconds() const { return seconds_; }
 
  private:
   struct Block {
-    RCP<Vector> u, p;
+    RCP<Vector> u, c;  // positions, constraints
   };
   Block newBlock() const;
-  static double dot(const Block& a, const Block& b) { return a.u->dot(*b.u) + a.p->dot(*b.p); }
+  static double dot(const Block& a, const Block& b) { return a.u->dot(*b.u) + a.c->dot(*b.c); }
   static void update(double alpha, const Block& x, double beta, Block& y) {
     y.u->update(alpha, *x.u, beta);
-    y.p->update(alpha, *x.p, beta);
+    y.c->update(alpha, *x.c, beta);
   }
-  // The volume gradients at the current positions into G^T (rows: elements).
-  void fillVolumeGradient();
+  // Every effect's rows at the current positions into B^T, the row vectors
+  // and the constraint map (rebuilt when the number of rows changes).
+  void fillRows();
   // y = A x (the scaled saddle-point matrix) and z = P^-1 r.
   void applySystem(const CrsMatrix& K, const Block& x, Block& y) const;
   void applyPreconditioner(const Inverse& Kinv, const Block& r, Block& z);
-  // max_e |r_p,e| / (w_e V_e): the relative volume error in a residual's constraint block.
-  double volumeError(const Vector& rp) const;
+  // max over the volume rows of |r_j| / (w_j scale_j): the relative volume
+  // error in a residual's constraint block.
+  double volumeError(const Vector& rc) const;
 
   Assembly& assembly_;
-  RCP<const Map> elementMap_;
-  RCP<CrsMatrix> gradient_;           // G^T: row e holds g_e on the free dofs
-  // Element rows of G^T over global dofs (Assembly::chainRows), refilled per solve.
-  std::vector<size_t> rowStart_;
-  std::vector<GO> cols_;
+  std::vector<ConstraintRows> effectRows_;  // per effect of assembly_.effects()
+  long rows_ = 0;
+  RCP<const Map> rowMap_;             // this rank's constraint rows, effect after effect
+  RCP<CrsMatrix> gradient_;           // B^T: row j holds B_j on the free dofs
+  // Rows of B^T over global dofs (Assembly::chainRows), refilled per solve;
+  // the last pattern, to refill the matrix in place while it is unchanged.
+  std::vector<size_t> rowStart_, lastRowStart_;
+  std::vector<GO> cols_, lastCols_;
   std::vector<double> vals_;
   template <class T>
-  Teuchos::ArrayView<const T> row(const std::vector<T>& v, size_t e) const {
-    return Teuchos::ArrayView<const T>(v.data() + rowStart_[e], rowStart_[e + 1] - rowStart_[e]);
+  Teuchos::ArrayView<const T> row(const std::vector<T>& v, size_t j) const {
+    return Teuchos::ArrayView<const T>(v.data() + rowStart_[j], rowStart_[j + 1] - rowStart_[j]);
   }
-  Matrix g_;                          // per element g_e (all 24 dofs)
-  RCP<Vector> weight_;                // w_e (0 for an element with no free dof)
-  RCP<Vector> schurInverse_;          // 1 / (w_e eps V_e) (0 likewise)
-  RCP<Vector> scratch_;               // applyPreconditioner's r_u + G z_p
-  RCP<Vector> residualP_;             // the constraint block of GMRES's residual
+  RCP<Vector> weight_;                // w_j (0 for a row with no free dof)
+  RCP<Vector> force_, diagonal_;      // F_j, D_j
+  RCP<Vector> schurInverse_;          // 1 / (w_j S_j) (0 likewise)
+  RCP<Vector> volumeScale_;           // w_j scale_j on the volume rows, 0 elsewhere
+  RCP<Vector> scratch_;               // applyPreconditioner's r_u - B F z_c
+  RCP<Vector> scratchC_;              // applySystem's F x_c
+  RCP<Vector> residualC_;             // the constraint block of GMRES's residual
   std::vector<Block> basis_;          // GMRES's Krylov basis, kept between solves
   double seconds_ = 0;
 };

@@ -266,6 +266,7 @@ class Run {
   std::unique_ptr<Assembly> assembly_;
   std::unique_ptr<NewtonSolver> newton_;
   std::unique_ptr<PressureStep> pressureStep_;  // null with Solver/Pressure Update = Anderson
+  std::vector<Kokkos::View<double*>> pressureStepDmu_;  // per effect: its multipliers' change in the step
   RCP<FEMatrix> predictorMatrix_;
   RCP<Vector> u_;
   std::unique_ptr<FieldWriter> writer_;
@@ -527,7 +528,6 @@ bool Run::saddlePointPressureStep(double t, Vector& f, StepRecord& rec) {
   auto W = newton_->matrix();
   assembly_->evaluate(*u_, &f, W.get());  // the tangent at the converged state
   Vector dx(assembly_->dofMap());
-  Kokkos::View<double*> dp("pressure step dp", bricks.pressureAnchor.extent(0));
   // Solved until the volume error it leaves (to first order: it predicted the
   // next pass's to a few per cent on G1) is a third of the volume tolerance, or
   // to kPressureStepTolerance while that is still far off (PressureStep::solve).
@@ -535,22 +535,30 @@ bool Run::saddlePointPressureStep(double t, Vector& f, StepRecord& rec) {
   PressureStep::Result step;
   try {
     step = pressureStep_->solve(*W, newton_->approximateInverse(), f, tolerance, volumeTarget,
-                                scene_.solver.get<int>("Max Linear Iterations"), dx, dp);
+                                scene_.solver.get<int>("Max Linear Iterations"), dx, pressureStepDmu_);
   } catch (const std::exception&) {  // e.g. a preconditioner that cannot be built: a plain pass
     return false;
   }
   rec.linear += step.iterations;
   rec.pressureStep += step.iterations;
   if (!opt_.quiet && rank0_ && std::getenv("CAPSTAN_NEWTON_LOG"))
-    std::printf("    pressure step: %d GMRES iterations, residual reduced %.2e, volume error left %.2e\n",
-                step.iterations, step.reduction, step.volumeResidual);
+    std::printf("    pressure step: %d GMRES iterations, residual reduced %.2e, volume error left %.2e, %d contact rows\n",
+                step.iterations, step.reduction, step.volumeResidual, step.contactRows);
   if (!(step.reduction < 1)) return false;
   u_->update(1.0, dx, 1.0);
   assembly_->applyConstraints(*u_, t);
-  auto pbar = bricks.pressureAnchor;
-  Kokkos::parallel_for(
-      "pressure step anchors", Kokkos::RangePolicy<ExecSpace>(0, pbar.extent(0)),
-      KOKKOS_LAMBDA(int e) { pbar(e) += dp(e); });
+  // Each effect's multipliers move by their part of dmu (contact's back into
+  // lambda >= 0: a point the step pulls free is released).
+  for (size_t i = 0; i < assembly_->effects().size(); ++i) {
+    Effect& e = *assembly_->effects()[i];
+    auto mu = e.multipliers();
+    auto d = pressureStepDmu_[i];
+    if (mu.extent(0) == 0 || d.extent(0) != mu.extent(0)) continue;
+    Kokkos::parallel_for(
+        "pressure step multipliers", Kokkos::RangePolicy<ExecSpace>(0, mu.extent(0)),
+        KOKKOS_LAMBDA(int k) { mu(k) += d(k); });
+    e.projectMultipliers();
+  }
   return true;
 }
 

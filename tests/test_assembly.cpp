@@ -113,11 +113,13 @@ TEST(PressureStep, SolvesTheMixedNewtonSystem) {
   const std::vector<double> v0 = copy(bricks.volume), V = copy(bricks.referenceVolume);
   const std::vector<double> pbar0 = copy(bricks.pressureAnchor);
   Vector dx(assembly.dofMap());
-  Kokkos::View<double*> dp("dp", bricks.pressureAnchor.extent(0));
+  std::vector<Kokkos::View<double*>> dmu;
   PressureStep step(assembly);
-  const auto result = step.solve(*W, newton.approximateInverse(), f, 1e-12, 0.0, 500, dx, dp);
+  const auto result = step.solve(*W, newton.approximateInverse(), f, 1e-12, 0.0, 500, dx, dmu);
   EXPECT_LT(result.reduction, 1e-11);
-  const std::vector<double> dph = copy(dp);
+  ASSERT_EQ(dmu.size(), assembly.effects().size());
+  const std::vector<double> dph = copy(dmu[0]);
+  ASSERT_EQ(assembly.effects()[0].get(), &bricks);
   auto setAnchors = [&](double s) {
     auto h = Kokkos::create_mirror_view(bricks.pressureAnchor);
     for (size_t e = 0; e < h.extent(0); ++e) h(e) = pbar0[e] + s * dph[e];
@@ -165,3 +167,120 @@ TEST(PressureStep, SolvesTheMixedNewtonSystem) {
 }
 
 }  // namespace
+
+namespace {
+
+// Each rank's constraint values c_j by (effect, multiplier index), at the last evaluation.
+std::map<std::pair<size_t, int>, double> constraintValues(Assembly& assembly) {
+  std::map<std::pair<size_t, int>, double> out;
+  ConstraintRows rows;
+  for (size_t i = 0; i < assembly.effects().size(); ++i) {
+    assembly.effects()[i]->constraintRows(assembly.positions(), rows);
+    for (size_t k = 0; k < rows.size(); ++k) out[{i, rows.multiplier[k]}] = rows.value[k];
+  }
+  return out;
+}
+
+}  // namespace
+
+// With exact contact the step also moves the contact multipliers: the points in
+// contact (t_n > 0) get rows c_q = g_q next to the volumes'. The same checks,
+// through the assembly's own residual and gaps: R is linear in every
+// multiplier (contact's while the points stay in contact), and every row's
+// linearisation c_j + dc_j/dx . dx = 0 is a central difference along dx.
+TEST(PressureStep, MovesContactMultipliersWithTheVolumes) {
+  auto comm = Tpetra::getDefaultComm();
+  Scene scene = boxScene();
+  CapstanSpec cap;
+  cap.name = "capstan";
+  cap.radius = 1;
+  cap.axisPoint = {1.1, 1 + 1 - 0.08, 0}, cap.axisDirection = {0, 0, 1};
+  cap.contactFaces = {"ymax"};
+  cap.method = "Augmented Lagrangian", cap.penalty = 1e-2, cap.maxAugmentations = 50;
+  cap.minimumSolvePenalty = -1;
+  cap.frictionLaw = "None";
+  scene.capstans = {cap};
+  BoxGenerator gen(scene.mesh.min, scene.mesh.max, scene.mesh.cells);
+  Mesh mesh = distributeMesh(gen, comm);
+  Assembly assembly(mesh, scene);
+  NewtonSolver newton(assembly, scene.solver);
+  Vector u(assembly.dofMap()), f(assembly.dofMap());
+  {
+    auto ud = u.getDataNonConst();
+    for (size_t n = 0; n < mesh.numOwnedNodes; ++n)
+      for (int i = 0; i < 3; ++i) ud[3 * n + i] = 0.3 * field(&mesh.X[3 * n], i);
+  }
+  assembly.applyConstraints(u, 0.0);
+  assembly.setInterval(0.0, 0.0);
+  auto W = newton.matrix();
+  ASSERT_TRUE(assembly.evaluate(u, &f, W.get()));
+  ASSERT_EQ(assembly.contacts().size(), 1u);
+  const auto c0 = constraintValues(assembly);
+
+  std::vector<Kokkos::View<double*>> dmu;
+  PressureStep step(assembly);
+  Vector dx(assembly.dofMap());
+  const auto result = step.solve(*W, newton.approximateInverse(), f, 1e-12, 0.0, 500, dx, dmu);
+  EXPECT_LT(result.reduction, 1e-11);
+  EXPECT_GT(result.contactRows, 8) << "the capstan must press the top face";
+  EXPECT_GT(step.rows(), long(result.contactRows));
+
+  // Momentum rows: K dx + (R(mu + s dmu) - R(mu)) / s + R = 0.
+  std::vector<std::vector<double>> mu0;
+  for (const auto& e : assembly.effects()) {
+    auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), e->multipliers());
+    mu0.emplace_back(h.data(), h.data() + h.size());
+  }
+  auto setMultipliers = [&](double s) {
+    for (size_t i = 0; i < mu0.size(); ++i) {
+      auto mu = assembly.effects()[i]->multipliers();
+      if (mu.extent(0) == 0) continue;
+      auto h = Kokkos::create_mirror_view(mu);
+      auto d = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), dmu[i]);
+      for (size_t k = 0; k < h.extent(0); ++k) h(k) = mu0[i][k] + s * d(k);
+      Kokkos::deep_copy(mu, h);
+    }
+  };
+  const double s = 1e-4;
+  Vector Kdx(assembly.dofMap()), fs(assembly.dofMap());
+  W->apply(dx, Kdx);
+  setMultipliers(s);
+  ASSERT_TRUE(assembly.evaluate(u, &fs, nullptr));
+  setMultipliers(0);
+  fs.update(-1 / s, f, 1 / s);  // (R(mu + s dmu) - R(mu)) / s
+  Kdx.update(1.0, fs, 1.0, f, 1.0);
+  const double momentum = Kdx.norm2(), scale = f.norm2() + fs.norm2();
+  ASSERT_GT(scale, 0);
+  EXPECT_LT(momentum, 1e-8 * scale) << "|K dx + B F dmu + R| = " << momentum;
+
+  // Constraint rows, volumes and contact points alike: (c(u + h dx) - c(u - h dx)) / 2h = -c
+  // (D = 0 here: exact contact, and the anchors do not enter v).
+  const double h = 1e-5;
+  std::map<std::pair<size_t, int>, double> cp, cm;
+  for (double sign : {1.0, -1.0}) {
+    Vector us(u, Teuchos::Copy);
+    us.update(sign * h, dx, 1.0);
+    ASSERT_TRUE(assembly.evaluate(us, nullptr, nullptr));
+    (sign > 0 ? cp : cm) = constraintValues(assembly);
+  }
+  const size_t contactEffect = [&] {
+    for (size_t i = 0; i < assembly.effects().size(); ++i)
+      if (assembly.effects()[i].get() == assembly.contacts()[0]) return i;
+    return size_t(0);
+  }();
+  double worst[2] = {0, 0}, largest[2] = {0, 0};
+  for (const auto& [key, c] : c0) {
+    ASSERT_TRUE(cp.count(key) && cm.count(key)) << "row " << key.first << "/" << key.second << " left contact";
+    const int kind = key.first == contactEffect ? 1 : 0;
+    worst[kind] = std::max(worst[kind], std::fabs((cp[key] - cm[key]) / (2 * h) + c));
+    largest[kind] = std::max(largest[kind], std::fabs(c));
+  }
+  for (int kind : {0, 1}) {
+    double w = 0, l = 0;
+    Teuchos::reduceAll(*comm, Teuchos::REDUCE_MAX, worst[kind], Teuchos::outArg(w));
+    Teuchos::reduceAll(*comm, Teuchos::REDUCE_MAX, largest[kind], Teuchos::outArg(l));
+    ASSERT_GT(l, 0);
+    EXPECT_LT(w, 1e-5 * l) << (kind ? "contact" : "volume") << " rows: max |c + dc/dx dx| = " << w
+                           << ", max |c| = " << l;
+  }
+}
