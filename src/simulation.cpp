@@ -458,7 +458,9 @@ bool Run::solveAt(double t0, double t, StepRecord& rec, std::string& failure) {
       assembly_->evaluate(*u_, &f, nullptr);
       tolIt = std::max(std::min(tol, 1e-4 * f.norm2()), 1e-3 * absTolerance_);
     }
+    const auto solveStart = Clock::now();
     const NewtonResult r = newton_->solve(*u_, tolIt);
+    const double solveSeconds = since(solveStart);
     rec.newton += r.iterations;
     rec.linear += r.linearIterations;
     rec.residual = r.residualNorm;
@@ -466,8 +468,8 @@ bool Run::solveAt(double t0, double t, StepRecord& rec, std::string& failure) {
     if (!opt_.quiet && rank0_ && std::getenv("CAPSTAN_NEWTON_LOG")) {
       std::printf("    newton |R|:");
       for (double n : r.residualHistory) std::printf(" %.3e", n);
-      std::printf("  (%d linear; preconditioners built: %d)\n", r.linearIterations,
-                  newton_->preconditionerBuilds());
+      std::printf("  (%d linear; preconditioners built: %d; %.3f s)\n", r.linearIterations,
+                  newton_->preconditionerBuilds(), solveSeconds);
     }
     // A later pass may start below what round-off lets Newton reach; a state
     // within the absolute tolerance is as converged as it gets.
@@ -533,6 +535,7 @@ bool Run::saddlePointPressureStep(double t, Vector& f, StepRecord& rec) {
   // to kPressureStepTolerance while that is still far off (PressureStep::solve).
   const double tolerance = kPressureStepTolerance, volumeTarget = kPressureStepVolumeMargin * bricks.constraintTolerance();
   PressureStep::Result step;
+  const auto stepStart = Clock::now();
   try {
     step = pressureStep_->solve(*W, newton_->approximateInverse(), f, tolerance, volumeTarget,
                                 scene_.solver.get<int>("Max Linear Iterations"), dx, pressureStepDmu_);
@@ -542,8 +545,9 @@ bool Run::saddlePointPressureStep(double t, Vector& f, StepRecord& rec) {
   rec.linear += step.iterations;
   rec.pressureStep += step.iterations;
   if (!opt_.quiet && rank0_ && std::getenv("CAPSTAN_NEWTON_LOG"))
-    std::printf("    pressure step: %d GMRES iterations, residual reduced %.2e, volume error left %.2e, %d contact rows\n",
-                step.iterations, step.reduction, step.volumeResidual, step.contactRows);
+    std::printf("    pressure step: %d GMRES iterations, residual reduced %.2e, volume error left %.2e, "
+                "%d contact rows; %.3f s\n",
+                step.iterations, step.reduction, step.volumeResidual, step.contactRows, since(stepStart));
   if (!(step.reduction < 1)) return false;
   u_->update(1.0, dx, 1.0);
   assembly_->applyConstraints(*u_, t);

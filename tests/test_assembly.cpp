@@ -37,6 +37,32 @@ double field(const double* X, int i) {
          (i == 0 ? 0.0 : 0.0);
 }
 
+// u = scale x field on the owned nodes.
+void setField(const Mesh& mesh, Vector& u, double scale) {
+  auto ud = u.getDataNonConst();
+  for (size_t n = 0; n < mesh.numOwnedNodes; ++n)
+    for (int i = 0; i < 3; ++i) ud[3 * n + i] = scale * field(&mesh.X[3 * n], i);
+}
+
+// A box scene's mesh, assembly and Newton solver, at u = scale x field (constraints applied).
+struct BoxProblem {
+  BoxProblem(const Scene& s, double scale)
+      : scene(s),
+        mesh(distributeMesh(BoxGenerator(s.mesh.min, s.mesh.max, s.mesh.cells), Tpetra::getDefaultComm())),
+        assembly(mesh, scene),
+        newton(assembly, scene.solver),
+        u(assembly.dofMap()),
+        f(assembly.dofMap()) {
+    setField(mesh, u, scale);
+    assembly.applyConstraints(u, 0.0);
+  }
+  Scene scene;
+  Mesh mesh;
+  Assembly assembly;
+  NewtonSolver newton;
+  Vector u, f;
+};
+
 // gid -> (residual, (K w)) for this communicator's owned dofs.
 std::map<GO, std::pair<double, double>> assemble(const RCP<const Comm>& comm) {
   const Scene scene = boxScene();
@@ -91,18 +117,8 @@ TEST(Assembly, DistributedEqualsSerial) {
 // G^T dx is a central difference of the volumes along dx.
 TEST(PressureStep, SolvesTheMixedNewtonSystem) {
   auto comm = Tpetra::getDefaultComm();
-  const Scene scene = boxScene();
-  BoxGenerator gen(scene.mesh.min, scene.mesh.max, scene.mesh.cells);
-  Mesh mesh = distributeMesh(gen, comm);
-  Assembly assembly(mesh, scene);
-  NewtonSolver newton(assembly, scene.solver);
-  Vector u(assembly.dofMap()), f(assembly.dofMap());
-  {
-    auto ud = u.getDataNonConst();
-    for (size_t n = 0; n < mesh.numOwnedNodes; ++n)
-      for (int i = 0; i < 3; ++i) ud[3 * n + i] = field(&mesh.X[3 * n], i);
-  }
-  assembly.applyConstraints(u, 0.0);
+  BoxProblem problem(boxScene(), 1.0);
+  auto& [scene, mesh, assembly, newton, u, f] = problem;
   BrickEffect& bricks = assembly.bricks();
   auto W = newton.matrix();
   ASSERT_TRUE(assembly.evaluate(u, &f, W.get()));
@@ -200,17 +216,8 @@ TEST(PressureStep, MovesContactMultipliersWithTheVolumes) {
   cap.minimumSolvePenalty = -1;
   cap.frictionLaw = "None";
   scene.capstans = {cap};
-  BoxGenerator gen(scene.mesh.min, scene.mesh.max, scene.mesh.cells);
-  Mesh mesh = distributeMesh(gen, comm);
-  Assembly assembly(mesh, scene);
-  NewtonSolver newton(assembly, scene.solver);
-  Vector u(assembly.dofMap()), f(assembly.dofMap());
-  {
-    auto ud = u.getDataNonConst();
-    for (size_t n = 0; n < mesh.numOwnedNodes; ++n)
-      for (int i = 0; i < 3; ++i) ud[3 * n + i] = 0.3 * field(&mesh.X[3 * n], i);
-  }
-  assembly.applyConstraints(u, 0.0);
+  BoxProblem problem(scene, 0.3);
+  auto& [sc, mesh, assembly, newton, u, f] = problem;
   assembly.setInterval(0.0, 0.0);
   auto W = newton.matrix();
   ASSERT_TRUE(assembly.evaluate(u, &f, W.get()));

@@ -2,7 +2,7 @@
 """Newton converges quadratically (the tangent is consistent with the residual).
 
 Runs inputs/shear.xml with CAPSTAN_NEWTON_LOG=1, which prints one line per Newton
-solve:   newton |R|: r0 r1 r2 ...  (N linear; preconditioners built: P)
+solve:   newton |R|: r0 r1 r2 ...  (N linear; preconditioners built: P; T s)
 as given (Auto linear solver: direct on one rank, tangent predictor), with
 Solver/Predictor=Previous (Newton starts farther from the solution: longer
 histories), and with Solver/Linear Solver=GMRES (the iterative path that
@@ -49,7 +49,7 @@ L = max(h - l for h, l in zip(info.vector("Mesh/Max", [1, 1, 1]), info.vector("M
 force_scale = c * L * L
 print(f"  c = {c}, body size L = {L}: force scale c L^2 = {force_scale}")
 
-LINE = re.compile(r"^\s*newton \|R\|:((?:\s+\S+)+?)\s+\((\d+) linear(?:; preconditioners built: \d+)?\)\s*$")
+LINE = re.compile(r"^\s*newton \|R\|:((?:\s+\S+)+?)\s+\((\d+) linear(?:; preconditioners built: \d+)?(?:; \S+ s)?\)\s*$")
 STEP = re.compile(r"^step (\d+)/(\d+)")
 
 
