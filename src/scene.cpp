@@ -180,7 +180,8 @@ ParameterList validParameters() {
   sol.set("Max Pressure Iterations", 100, "Most pressure-anchor updates per step");
   sol.set("Pressure Update", std::string("Auto"),
           "How the pressure loop moves the element pressure anchors after each Newton solve: "
-          "Saddle Point (positions and anchors from one block Krylov solve, v_e = V_e to first order), "
+          "Saddle Point (positions, anchors and exact contact's multipliers from one block Krylov solve, "
+          "v_e = V_e and g = 0 to first order), "
           "Anderson (pbar <- p(x), Anderson-accelerated), or Auto (Saddle Point without friction, "
           "Anderson with it)");
   sol.set("Pressure Acceleration Depth", 5,
