@@ -2,6 +2,7 @@
 
 #include <Kokkos_Timer.hpp>
 
+#include <algorithm>
 #include <cmath>
 
 namespace capstan {
@@ -132,9 +133,9 @@ PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv
     size_t j = 0;
     for (size_t i = 0; i < effectRows_.size(); ++i)
       for (size_t k = 0; k < effectRows_[i].size(); ++k, ++j) r[j] = -w[j] * effectRows_[i].value[k];
+    // The rows the stop rule does not look at: contact points.
     long contact = 0, all = 0;
-    for (size_t i = 0; i < effectRows_.size(); ++i)
-      if (assembly_.effects()[i].get() != &assembly_.bricks()) contact += long(effectRows_[i].size());
+    for (const ConstraintRows& rows : effectRows_) contact += long(std::count(rows.scale.begin(), rows.scale.end(), 0.0));
     Teuchos::reduceAll(*rowMap_->getComm(), Teuchos::REDUCE_SUM, contact, Teuchos::outArg(all));
     result.contactRows = int(all);
   }
