@@ -1,14 +1,27 @@
 #include "pressure_step.hpp"
 
 #include <Kokkos_Timer.hpp>
+#include <TpetraExt_MatrixMatrix.hpp>
 
 #include <algorithm>
 #include <cmath>
 
 namespace capstan {
 
-PressureStep::PressureStep(Assembly& assembly)
-    : assembly_(assembly), effectRows_(assembly.effects().size()) {
+namespace {
+// S^-1 ~ (eps M)^-1 + kLaplacianWeight L^-1, L^-1 by kLaplacianIterations of
+// CG: G1 4x (30.6 s with the diagonal S) took 28.2 s at 0.15 and 30, 28.8 s at
+// 0.25, 31.7 s at 1 (more passes: the steps' larger pressure changes leave a
+// larger nonlinear remainder), 29.9 s at 15 or 50 iterations. An exact L^-1
+// (a direct solve) at 0.5 takes the last pass from 73 to 19 iterations; a MueLu
+// V-cycle for it instead makes the step slower than the diagonal alone (its
+// coarse levels do not hold the nearly spurious modes).
+constexpr double kLaplacianWeight = 0.15;
+constexpr int kLaplacianIterations = 30;
+}  // namespace
+
+PressureStep::PressureStep(Assembly& assembly, Schur schur)
+    : assembly_(assembly), effectRows_(assembly.effects().size()), schur_(schur) {
   scratch_ = rcp(new Vector(assembly_.dofMap()));
 }
 
@@ -33,6 +46,7 @@ void PressureStep::fillRows() {
     for (auto* v : {&weight_, &force_, &diagonal_, &schurInverse_, &volumeScale_, &scratchC_, &residualC_})
       *v = rcp(new Vector(rowMap_));
     basis_.clear();
+    preconditioned_.clear();
     lastRowStart_.clear();
   }
   rows_ = long(rowMap_->getGlobalNumElements());
@@ -88,6 +102,82 @@ void PressureStep::fillRows() {
   gradient_->fillComplete(assembly_.dofMap(), rowMap_);
 }
 
+void PressureStep::buildVolumeLaplacian(const CrsMatrix& K) {
+  // The volume rows, their 1 / w_j and 1 / S_j.
+  volumeRows_ = rcp(new Vector(rowMap_));
+  volumeRowsOverW_ = rcp(new Vector(rowMap_));
+  Vector schurInverse(rowMap_);
+  {
+    auto m = volumeRows_->getDataNonConst();
+    auto mw = volumeRowsOverW_->getDataNonConst();
+    auto si = schurInverse.getDataNonConst();
+    auto vs = volumeScale_->getData();
+    auto w = weight_->getData();
+    auto wsInv = schurInverse_->getData();
+    for (size_t j = 0; j < size_t(m.size()); ++j) {
+      const bool volume = vs[j] > 0;
+      m[j] = volume ? 1.0 : 0.0;
+      mw[j] = volume ? 1 / w[j] : 0.0;
+      si[j] = volume ? wsInv[j] * w[j] : 0.0;
+    }
+  }
+  // diag(K0) = diag(K) - diag(G (eps M)^-1 G^T): K without the volume penalty.
+  Vector diagK(K.getRowMap()), penalty(assembly_.dofMap()), diagK0Inverse(assembly_.dofMap());
+  K.getLocalDiagCopy(diagK);
+  auto G = rcp(new CrsMatrix(*gradient_, Teuchos::Copy));
+  G->leftScale(*volumeRows_);  // the volume rows only
+  {
+    auto squared = rcp(new CrsMatrix(*G, Teuchos::Copy));
+    auto v = squared->getLocalMatrixDevice().values;
+    Kokkos::parallel_for(
+        "squared gradient", Kokkos::RangePolicy<ExecSpace>(0, v.extent(0)), KOKKOS_LAMBDA(int k) { v(k) *= v(k); });
+    Kokkos::fence();
+    squared->apply(schurInverse, penalty, Teuchos::TRANS);
+  }
+  {
+    auto d = diagK.getData();
+    auto pen = penalty.getData();
+    auto out = diagK0Inverse.getDataNonConst();
+    for (size_t i = 0; i < size_t(out.size()); ++i) {
+      // K0 is positive definite; guard against round-off where the penalty dominates.
+      const double k0 = std::max(d[i] - pen[i], 1e-3 * d[i]);
+      out[i] = d[i] > 0 ? 1 / k0 : 0.0;
+    }
+  }
+  auto GD = rcp(new CrsMatrix(*G, Teuchos::Copy));
+  GD->rightScale(diagK0Inverse);
+  laplacian_ = rcp(new CrsMatrix(rowMap_, 0));
+  Tpetra::MatrixMatrix::Multiply(*GD, false, *G, true, *laplacian_);
+  laplacianJacobi_ = rcp(new Vector(rowMap_));
+  laplacian_->getLocalDiagCopy(*laplacianJacobi_);
+  {
+    auto d = laplacianJacobi_->getDataNonConst();
+    for (size_t j = 0; j < size_t(d.size()); ++j) d[j] = d[j] > 0 ? 1 / d[j] : 0.0;
+  }
+  for (auto* v : {&cgR_, &cgP_, &cgQ_, &cgZ_, &laplacianIn_, &laplacianOut_}) *v = rcp(new Vector(rowMap_));
+}
+
+void PressureStep::applyVolumeLaplacianInverse(const Vector& b, Vector& x) const {
+  // Jacobi-preconditioned CG from 0; rows outside the volumes stay 0.
+  x.putScalar(0.0);
+  cgR_->update(1.0, b, 0.0);
+  cgZ_->elementWiseMultiply(1.0, *laplacianJacobi_, *cgR_, 0.0);
+  cgP_->update(1.0, *cgZ_, 0.0);
+  double rz = cgR_->dot(*cgZ_);
+  for (int it = 0; it < kLaplacianIterations && rz > 0; ++it) {
+    laplacian_->apply(*cgP_, *cgQ_);
+    const double pq = cgP_->dot(*cgQ_);
+    if (!(pq > 0)) break;
+    const double alpha = rz / pq;
+    x.update(alpha, *cgP_, 1.0);
+    cgR_->update(-alpha, *cgQ_, 1.0);
+    cgZ_->elementWiseMultiply(1.0, *laplacianJacobi_, *cgR_, 0.0);
+    const double rzNext = cgR_->dot(*cgZ_);
+    cgP_->update(1.0, *cgZ_, rzNext / rz);
+    rz = rzNext;
+  }
+}
+
 void PressureStep::applySystem(const CrsMatrix& K, const Block& x, Block& y) const {
   // y_u = K x_u + B F x_c
   K.apply(*x.u, *y.u);
@@ -102,6 +192,12 @@ void PressureStep::applySystem(const CrsMatrix& K, const Block& x, Block& y) con
 void PressureStep::applyPreconditioner(const Inverse& Kinv, const Block& r, Block& z) {
   // z_c = (w S)^-1 r_c, then z_u = K~^-1 (r_u - B F z_c)
   z.c->elementWiseMultiply(1.0, *schurInverse_, *r.c, 0.0);
+  if (schur_ == Schur::Laplacian) {
+    // + omega L^-1 w^-1 r_c on the volume rows
+    laplacianIn_->elementWiseMultiply(1.0, *volumeRowsOverW_, *r.c, 0.0);
+    applyVolumeLaplacianInverse(*laplacianIn_, *laplacianOut_);
+    z.c->update(kLaplacianWeight, *laplacianOut_, 1.0);
+  }
   scratchC_->elementWiseMultiply(1.0, *force_, *z.c, 0.0);
   scratch_->update(1.0, *r.u, 0.0);
   gradient_->apply(*scratchC_, *scratch_, Teuchos::TRANS, -1.0, 1.0);
@@ -123,6 +219,7 @@ PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv
                                          std::vector<Kokkos::View<double*>>& dmu) {
   Kokkos::Timer timer;
   fillRows();
+  if (schur_ == Schur::Laplacian) buildVolumeLaplacian(K);
   Result result;
   // Right-hand side: (-R, -w .* c).
   Block rhs = newBlock();
@@ -139,7 +236,7 @@ PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv
     Teuchos::reduceAll(*rowMap_->getComm(), Teuchos::REDUCE_SUM, contact, Teuchos::outArg(all));
     result.contactRows = int(all);
   }
-  Block x = newBlock(), work = newBlock(), z = newBlock();
+  Block x = newBlock(), work = newBlock();
   const double beta0 = std::sqrt(dot(rhs, rhs));
   // Done: the volume error left meets the target, or the residual is reduced
   // by `tolerance` and the volume error is far from the target anyway. Going
@@ -170,9 +267,10 @@ PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv
     double res = beta;
     while (k < m && result.iterations < maxIterations) {
       if (basis_.size() < size_t(k + 2)) basis_.push_back(newBlock());  // allocated as the cycle needs
-      applyPreconditioner(Kinv, basis_[k], z);
+      if (preconditioned_.size() < size_t(k + 1)) preconditioned_.push_back(newBlock());
+      applyPreconditioner(Kinv, basis_[k], preconditioned_[k]);
       Block& w = basis_[k + 1];
-      applySystem(K, z, w);
+      applySystem(K, preconditioned_[k], w);
       for (int i = 0; i <= k; ++i) {
         h(i, k) = dot(w, basis_[i]);
         update(-h(i, k), basis_[i], 1.0, w);
@@ -201,17 +299,14 @@ PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv
       ++k, ++result.iterations;
       if (done(res, volumeLeft) || b == 0) break;
     }
-    // x += P^-1 (basis y), y = H^-1 s (upper triangular after the rotations)
+    // x += (P^-1 basis) y, y = H^-1 s (upper triangular after the rotations)
     std::vector<double> y(k, 0.0);
     for (int i = k - 1; i >= 0; --i) {
       double t = s[i];
       for (int j = i + 1; j < k; ++j) t -= h(i, j) * y[j];
       y[i] = h(i, i) != 0 ? t / h(i, i) : 0.0;
     }
-    r.u->putScalar(0.0), r.c->putScalar(0.0);
-    for (int i = 0; i < k; ++i) update(y[i], basis_[i], 1.0, r);
-    applyPreconditioner(Kinv, r, z);
-    update(1.0, z, 1.0, x);
+    for (int i = 0; i < k; ++i) update(y[i], preconditioned_[i], 1.0, x);
     // The true residual, for the next cycle and the figure reported.
     applySystem(K, x, r);
     update(1.0, rhs, -1.0, r);

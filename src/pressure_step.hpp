@@ -26,8 +26,22 @@
 //
 //     P = [ K~  B F ; 0  S ],   K~^-1: Newton's preconditioner,
 //
-// needs about the iterations of one Newton solve plus a few for those modes,
-// where the plain loop needs a Newton solve per pass.
+// needs about the iterations of one Newton solve plus those for the modes S
+// misses, where the plain loop needs a Newton solve per pass.
+//
+// Those modes (Schur = Laplacian, the default): K = K0 + G (eps M)^-1 G^T on
+// the volumes, so by Sherman-Morrison-Woodbury the volumes' Schur complement
+// has the inverse (eps M)^-1 + (G^T K0^-1 G)^-1. Its second term is small
+// except on the nearly spurious modes (G q ~ 0), where it is large; the
+// diagonal S drops it, and those modes took 73-98 GMRES iterations in each
+// load step's last pass (G1 4x). L = G^T diag(K0)^-1 G is small on the same
+// modes (G q ~ 0 makes both small), so the step applies
+//     S^-1 ~ (eps M)^-1 + omega L^-1
+// on the volume rows, L^-1 by a few Jacobi-preconditioned CG iterations (L is
+// a scalar element-by-element matrix, ~1/30 of K's nonzeros). A fixed number of
+// CG iterations is not a linear operator, so GMRES is the flexible variant
+// (it keeps P^-1 of each basis vector). omega and the CG iterations were
+// chosen from G1 4x and 8x (docs/performance.md).
 //
 // Each constraint row is scaled by w_j = |F_j| |B_j| / |S_j|: a constraint
 // error then counts as the force it causes through the penalty, comparable
@@ -44,7 +58,9 @@ namespace capstan {
 
 class PressureStep {
  public:
-  explicit PressureStep(Assembly& assembly);
+  // How the constraint block's Schur complement is approximated (above).
+  enum class Schur { Diagonal, Laplacian };
+  explicit PressureStep(Assembly& assembly, Schur schur = Schur::Laplacian);
 
   // z = K~^-1 r, an approximate inverse of K.
   using Inverse = std::function<void(const Vector& r, Vector& z)>;
@@ -84,6 +100,10 @@ class PressureStep {
   // Every effect's rows at the current positions into B^T, the row vectors
   // and the constraint map (rebuilt when the number of rows changes).
   void fillRows();
+  // L = G^T diag(K0)^-1 G on the volume rows (zero rows elsewhere) at K.
+  void buildVolumeLaplacian(const CrsMatrix& K);
+  // z ~ L^-1 r on the volume rows: kLaplacianIterations of Jacobi-CG.
+  void applyVolumeLaplacianInverse(const Vector& r, Vector& z) const;
   // y = A x (the scaled saddle-point matrix) and z = P^-1 r.
   void applySystem(const CrsMatrix& K, const Block& x, Block& y) const;
   void applyPreconditioner(const Inverse& Kinv, const Block& r, Block& z);
@@ -113,6 +133,13 @@ class PressureStep {
   RCP<Vector> scratchC_;              // applySystem's F x_c
   RCP<Vector> residualC_;             // the constraint block of GMRES's residual
   std::vector<Block> basis_;          // GMRES's Krylov basis, kept between solves
+  std::vector<Block> preconditioned_; // P^-1 of each basis vector (flexible GMRES)
+  Schur schur_;
+  RCP<CrsMatrix> laplacian_;          // L (Schur::Laplacian)
+  RCP<Vector> laplacianJacobi_;       // 1 / L_jj on the volume rows, 0 elsewhere
+  RCP<Vector> volumeRowsOverW_;       // 1 / w_j on the volume rows, 0 elsewhere
+  RCP<Vector> volumeRows_;            // 1 on the volume rows, 0 elsewhere
+  mutable RCP<Vector> cgR_, cgP_, cgQ_, cgZ_, laplacianIn_, laplacianOut_;
   double seconds_ = 0;
 };
 

@@ -1327,7 +1327,9 @@ int Run::execute() {
     throw InputError(scene_.file + ": " + e.what());
   }
   if (scene_.solver.get<std::string>("Pressure Update") == "Saddle Point")
-    pressureStep_ = std::make_unique<PressureStep>(*assembly_);
+    pressureStep_ = std::make_unique<PressureStep>(
+        *assembly_, scene_.solver.get<std::string>("Pressure Step Schur") == "Diagonal" ? PressureStep::Schur::Diagonal
+                                                                                         : PressureStep::Schur::Laplacian);
   u_ = rcp(new Vector(assembly_->dofMap()));
   for (const auto& core : assembly_->rigidCores()) rolling_ = rolling_ || core.free[3];
   double size2 = 0;
