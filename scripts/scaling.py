@@ -12,7 +12,7 @@ count runs the same method, and writes
                       with the ideal slope (time proportional to DOFs) drawn
 
     scripts/scaling.py [--out out/scaling] [--g1 1,2,4] [--h1 2,4,8] [--ranks 1,2]
-                       [--steps N] [--capstan build/capstan]
+                       [--steps N] [--capstan build/capstan] [--set PATH=VALUE]...
 
 Runs whose summary.json exists are reused (delete OUT/<run>/ to redo one); a
 run made by hand may leave its CAPSTAN_NEWTON_LOG=1 output in OUT/<run>/run.log,
@@ -38,6 +38,9 @@ ap.add_argument("--g1", default="1,2,4", help="G1 refinement factors ('' for non
 ap.add_argument("--h1", default="2,4,8", help="H1 refinement factors ('' for none)")
 ap.add_argument("--ranks", default="1,2")
 ap.add_argument("--steps", type=int, default=0, help="run only this many steps (0: the scene's)")
+ap.add_argument("--set", action="append", default=[], metavar="PATH=VALUE",
+                help="an extra scene parameter for every run (capstan run --set), e.g. "
+                     "'Solver/Pressure Step Schur=Diagonal'; repeatable")
 args = ap.parse_args()
 
 CASES = {"G1": ("inputs/seed/g1.xml", (14, 4, 6)), "H1": ("inputs/seed/h1.xml", (20, 2, 1))}
@@ -62,6 +65,8 @@ for case, f in plan:
                    "--set", "Mesh/Cells={%d,%d,%d}" % tuple(cells),
                    "--set", "Solver/Linear Solver=GMRES", "--set", "Solver/Preconditioner=MueLu",
                    "--set", "Output/Write Fields=false"]
+            for extra in args.set:
+                cmd += ["--set", extra]
             if args.steps:
                 cmd += ["--set", f"Time/Steps={args.steps}"]
             if ranks > 1:
