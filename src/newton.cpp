@@ -549,6 +549,8 @@ std::function<void(const Vector&, Vector&)> NewtonSolver::approximateInverse() {
   };
 }
 
+bool NewtonSolver::iterative() const { return !impl_->newtonPrecFactory.is_null(); }
+
 int NewtonSolver::preconditionerBuilds() const {
   return impl_->newtonPrecFactory.is_null() ? 0 : impl_->newtonPrecFactory->builds();
 }

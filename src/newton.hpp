@@ -51,6 +51,8 @@ class NewtonSolver {
   double preconditionerSeconds() const;
   // Preconditioners Newton has built so far (the lagged one; CAPSTAN_NEWTON_LOG).
   int preconditionerBuilds() const;
+  // Whether the linear solves are Krylov solves (false: a direct solver).
+  bool iterative() const;
   // The linear solver and preconditioner parameters in use (Stratimikos list).
   const Teuchos::ParameterList& linearSolverParameters() const;
 

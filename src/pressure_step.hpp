@@ -72,11 +72,11 @@ class PressureStep {
   };
   // At the last evaluation (f its residual, K its tangent, the effects' states
   // and the positions): dx (owned dofs, zero on held ones) and dmu.
-  // GMRES stops once the volume error the step leaves (max_e, relative) is at
-  // most volumeTarget: then this pass meets the volume tolerance. Failing
-  // that, at the residual reduction `tolerance`, if the volume error left is
-  // still above 10 volumeTarget (the next pass, quadratically closer, finishes
-  // the job); close to the target it goes on (for at most as many iterations
+  // GMRES first reduces the residual by `tolerance`. It stops there if the
+  // volume error the step leaves (max_e, relative) is at most volumeTarget
+  // (this pass then meets the volume tolerance) or still above 10 volumeTarget
+  // (the next pass, quadratically closer, finishes the job); close to the
+  // target it goes on until it meets it (for at most as many iterations
   // again), since a pass (a Newton solve and a pressure step) costs more than
   // the iterations that remain. volumeTarget 0: the reduction alone.
   // dmu: every effect's multiplier changes, in its multipliers() layout

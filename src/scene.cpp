@@ -184,10 +184,12 @@ ParameterList validParameters() {
           "v_e = V_e and g = 0 to first order), "
           "Anderson (pbar <- p(x), Anderson-accelerated), or Auto (Saddle Point without friction, "
           "Anderson with it)");
-  sol.set("Pressure Step Schur", std::string("Laplacian"),
+  sol.set("Pressure Step Schur", std::string("Auto"),
           "The saddle-point step's approximation of its volume rows' Schur complement: Laplacian "
           "((eps V)^-1 + 0.15 L^-1, L = G^T diag(K0)^-1 G by 30 CG iterations: it holds Q1P0's nearly "
-          "spurious pressure modes) or Diagonal ((eps V)^-1 alone). The same answer either way");
+          "spurious pressure modes), Diagonal ((eps V)^-1 alone), or Auto (Laplacian with Krylov "
+          "linear solves, Diagonal with a direct solver, whose exact K^-1 leaves it little to gain). "
+          "The same answer either way");
   sol.set("Pressure Acceleration Depth", 5,
           "Anderson acceleration depth of the pressure loop (0 = plain pbar <- p(x))");
   sol.set("Minimum Solve Penalty", -1.0,
@@ -982,7 +984,7 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
   oneOf("Linear Tolerance Method", {"Adaptive", "Fixed"});
   oneOf("Preconditioner Reuse", {"Adaptive", "None"});
   oneOf("Pressure Update", {"Auto", "Saddle Point", "Anderson"});
-  oneOf("Pressure Step Schur", {"Laplacian", "Diagonal"});
+  oneOf("Pressure Step Schur", {"Auto", "Laplacian", "Diagonal"});
   for (const char* n : {"Linear Tolerance", "Newton Relative Tolerance", "Volume Tolerance"}) {
     const double x = sol.get<double>(n);
     if (!(x > 0 && x < 1)) v.fail(std::string("Solver/") + n, "must be in (0, 1)");

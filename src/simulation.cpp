@@ -1326,10 +1326,12 @@ int Run::execute() {
   } catch (const InputError& e) {  // the Solver/NOX or Solver/Stratimikos sublist
     throw InputError(scene_.file + ": " + e.what());
   }
-  if (scene_.solver.get<std::string>("Pressure Update") == "Saddle Point")
+  if (scene_.solver.get<std::string>("Pressure Update") == "Saddle Point") {
+    const std::string schur = scene_.solver.get<std::string>("Pressure Step Schur");
+    const bool laplacian = schur == "Laplacian" || (schur == "Auto" && newton_->iterative());
     pressureStep_ = std::make_unique<PressureStep>(
-        *assembly_, scene_.solver.get<std::string>("Pressure Step Schur") == "Diagonal" ? PressureStep::Schur::Diagonal
-                                                                                         : PressureStep::Schur::Laplacian);
+        *assembly_, laplacian ? PressureStep::Schur::Laplacian : PressureStep::Schur::Diagonal);
+  }
   u_ = rcp(new Vector(assembly_->dofMap()));
   for (const auto& core : assembly_->rigidCores()) rolling_ = rolling_ || core.free[3];
   double size2 = 0;
