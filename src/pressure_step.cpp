@@ -10,7 +10,8 @@ namespace capstan {
 
 namespace {
 // S^-1 ~ (eps M)^-1 + kLaplacianWeight L^-1, L^-1 by kLaplacianIterations of
-// CG: G1 4x (30.6 s with the diagonal S) took 28.2 s at 0.15 and 30, 28.8 s at
+// CG, chosen before the step's stop rule demanded the 1e-3 first (docs/performance.md):
+// G1 4x (30.6 s with the diagonal S) took 28.2 s at 0.15 and 30, 28.8 s at
 // 0.25, 31.7 s at 1 (more passes: the steps' larger pressure changes leave a
 // larger nonlinear remainder), 29.9 s at 15 or 50 iterations. An exact L^-1
 // (a direct solve) at 0.5 takes the last pass from 73 to 19 iterations; a MueLu
@@ -45,6 +46,10 @@ void PressureStep::fillRows() {
                           GO(0), comm));
     for (auto* v : {&weight_, &force_, &diagonal_, &schurInverse_, &volumeScale_, &scratchC_, &residualC_})
       *v = rcp(new Vector(rowMap_));
+    if (schur_ == Schur::Laplacian)
+      for (auto* v : {&volumeRows_, &volumeRowsOverW_, &laplacianJacobi_, &cgR_, &cgP_, &cgQ_, &cgZ_, &laplacianIn_,
+                      &laplacianOut_})
+        *v = rcp(new Vector(rowMap_));
     basis_.clear();
     preconditioned_.clear();
     lastRowStart_.clear();
@@ -103,9 +108,7 @@ void PressureStep::fillRows() {
 }
 
 void PressureStep::buildVolumeLaplacian(const CrsMatrix& K) {
-  // The volume rows, their 1 / w_j and 1 / S_j.
-  volumeRows_ = rcp(new Vector(rowMap_));
-  volumeRowsOverW_ = rcp(new Vector(rowMap_));
+  // The volume rows, their 1 / w_j and 1 / S_j (vectors on the row map: fillRows).
   Vector schurInverse(rowMap_);
   {
     auto m = volumeRows_->getDataNonConst();
@@ -148,13 +151,11 @@ void PressureStep::buildVolumeLaplacian(const CrsMatrix& K) {
   GD->rightScale(diagK0Inverse);
   laplacian_ = rcp(new CrsMatrix(rowMap_, 0));
   Tpetra::MatrixMatrix::Multiply(*GD, false, *G, true, *laplacian_);
-  laplacianJacobi_ = rcp(new Vector(rowMap_));
   laplacian_->getLocalDiagCopy(*laplacianJacobi_);
   {
     auto d = laplacianJacobi_->getDataNonConst();
     for (size_t j = 0; j < size_t(d.size()); ++j) d[j] = d[j] > 0 ? 1 / d[j] : 0.0;
   }
-  for (auto* v : {&cgR_, &cgP_, &cgQ_, &cgZ_, &laplacianIn_, &laplacianOut_}) *v = rcp(new Vector(rowMap_));
 }
 
 void PressureStep::applyVolumeLaplacianInverse(const Vector& b, Vector& x) const {
