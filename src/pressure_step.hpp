@@ -68,21 +68,26 @@ class PressureStep {
     int iterations = 0;
     double reduction = 1;  // final / initial residual (both blocks, scaled)
     double volumeResidual = 0;  // max_e |V_e - v_e - g_e.dx| / V_e: the volume error the step leaves (to first order)
+    double volumePredicted = 0;  // > 0: stopped early on this volume error predicted after Newton's next solve
+    int predictions = 0;         // stop-rule checks of that prediction (each one K~^-1)
     int contactRows = 0;        // contact points in the step (all ranks)
   };
   // At the last evaluation (f its residual, K its tangent, the effects' states
   // and the positions): dx (owned dofs, zero on held ones) and dmu.
-  // GMRES first reduces the residual by `tolerance`. It stops there if the
-  // volume error the step leaves (max_e, relative) is at most volumeTarget
-  // (this pass then meets the volume tolerance) or still above 10 volumeTarget
-  // (the next pass, quadratically closer, finishes the job); close to the
-  // target it goes on until it meets it (for at most as many iterations
-  // again), since a pass (a Newton solve and a pressure step) costs more than
-  // the iterations that remain. volumeTarget 0: the reduction alone.
+  // GMRES stops early once the volume error predicted after the next Newton
+  // solve (max_e, relative: the step's own constraint residual plus
+  // B^T K~^-1 r_u, the volume change of removing the momentum residual r_u it
+  // leaves) is at most predictionTarget (0: never). Otherwise it reduces the residual by
+  // `tolerance` and stops there if the volume error the step leaves is at most
+  // volumeTarget (this pass then meets the volume tolerance) or still above
+  // 10 volumeTarget (the next pass, quadratically closer, finishes the job);
+  // close to the target it goes on until it meets it (for at most as many
+  // iterations again), since a pass (a Newton solve and a pressure step) costs
+  // more than the iterations that remain. volumeTarget 0: the reduction alone.
   // dmu: every effect's multiplier changes, in its multipliers() layout
   // (zero where it has no row; empty views for effects without multipliers).
   Result solve(const CrsMatrix& K, const Inverse& Kinv, const Vector& f, double tolerance, double volumeTarget,
-               int maxIterations, Vector& dx, std::vector<Kokkos::View<double*>>& dmu);
+               double predictionTarget, int maxIterations, Vector& dx, std::vector<Kokkos::View<double*>>& dmu);
   // Constraint rows of the last solve (all ranks): volumes and contact points.
   long rows() const { return rows_; }
   double seconds() const { return seconds_; }
@@ -110,6 +115,9 @@ class PressureStep {
   // max over the volume rows of |r_j| / (w_j scale_j): the relative volume
   // error in a residual's constraint block.
   double volumeError(const Vector& rc) const;
+  // The volume error after the next Newton solve, for the residual (ru, rc):
+  // volumeError(rc - w .* B^T K~^-1 ru).
+  double predictedVolumeError(const Inverse& Kinv, const Vector& ru, const Vector& rc);
 
   Assembly& assembly_;
   std::vector<ConstraintRows> effectRows_;  // per effect of assembly_.effects()
@@ -132,6 +140,8 @@ class PressureStep {
   RCP<Vector> scratch_;               // applyPreconditioner's r_u - B F z_c
   RCP<Vector> scratchC_;              // applySystem's F x_c
   RCP<Vector> residualC_;             // the constraint block of GMRES's residual
+  RCP<Vector> residualU_, predictU_;  // its position block; K~^-1 of it
+  RCP<Vector> predictC_;              // rc - w .* B^T K~^-1 ru
   std::vector<Block> basis_;          // GMRES's Krylov basis, kept between solves
   std::vector<Block> preconditioned_; // P^-1 of each basis vector (flexible GMRES)
   Schur schur_;
