@@ -110,6 +110,35 @@ TEST(Assembly, DistributedEqualsSerial) {
   EXPECT_EQ(total, long(serial.size()));
 }
 
+// A view's values on the host.
+std::vector<double> hostCopy(const Kokkos::View<double*>& v) {
+  auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), v);
+  return std::vector<double>(h.data(), h.data() + h.size());  // (on the host the mirror is v itself)
+}
+
+// The bricks' pressure anchors at pbar0 + s dp.
+void setAnchors(BrickEffect& bricks, const std::vector<double>& pbar0, const std::vector<double>& dp, double s) {
+  auto h = Kokkos::create_mirror_view(bricks.pressureAnchor);
+  for (size_t e = 0; e < h.extent(0); ++e) h(e) = pbar0[e] + s * dp[e];
+  Kokkos::deep_copy(bricks.pressureAnchor, h);
+}
+
+// G^T d: the element volumes' rate along d at u, (v(u + h d) - v(u - h d)) / 2h
+// (v is cubic in x: the difference's error goes as h^2; seen 3.7e-5, 3.7e-7 of
+// max |V - v| = 0.02 at h = 1e-3, 1e-4 along a long step, far from equilibrium).
+std::vector<double> volumeRate(Assembly& assembly, const Vector& u, const Vector& d) {
+  const double h = 1e-5;
+  std::vector<double> vp, vm;
+  for (double sign : {1.0, -1.0}) {
+    Vector us(u, Teuchos::Copy);
+    us.update(sign * h, d, 1.0);
+    EXPECT_TRUE(assembly.evaluate(us, nullptr, nullptr));
+    (sign > 0 ? vp : vm) = hostCopy(assembly.bricks().volume);
+  }
+  for (size_t e = 0; e < vp.size(); ++e) vp[e] = (vp[e] - vm[e]) / (2 * h);
+  return vp;
+}
+
 // The saddle-point pressure step solves the mixed problem's Newton system
 //   K dx - G dp = -R,   G^T dx = V - v      (G: column e = d v_e / d x)
 // checked with the assembly's own residual and volumes, not the step's G:
@@ -122,51 +151,33 @@ TEST(PressureStep, SolvesTheMixedNewtonSystem) {
   BrickEffect& bricks = assembly.bricks();
   auto W = newton.matrix();
   ASSERT_TRUE(assembly.evaluate(u, &f, W.get()));
-  auto copy = [](const Kokkos::View<double*>& v) {
-    auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), v);
-    return std::vector<double>(h.data(), h.data() + h.size());  // (on the host the mirror is v itself)
-  };
-  const std::vector<double> v0 = copy(bricks.volume), V = copy(bricks.referenceVolume);
-  const std::vector<double> pbar0 = copy(bricks.pressureAnchor);
+  const std::vector<double> v0 = hostCopy(bricks.volume), V = hostCopy(bricks.referenceVolume);
+  const std::vector<double> pbar0 = hostCopy(bricks.pressureAnchor);
   Vector dx(assembly.dofMap());
   std::vector<Kokkos::View<double*>> dmu;
   PressureStep step(assembly);
   const auto result = step.solve(*W, newton.approximateInverse(), f, 1e-12, 0.0, 0.0, 500, dx, dmu);
   EXPECT_LT(result.reduction, 1e-11);
   ASSERT_EQ(dmu.size(), assembly.effects().size());
-  const std::vector<double> dph = copy(dmu[0]);
+  const std::vector<double> dph = hostCopy(dmu[0]);
   ASSERT_EQ(assembly.effects()[0].get(), &bricks);
-  auto setAnchors = [&](double s) {
-    auto h = Kokkos::create_mirror_view(bricks.pressureAnchor);
-    for (size_t e = 0; e < h.extent(0); ++e) h(e) = pbar0[e] + s * dph[e];
-    Kokkos::deep_copy(bricks.pressureAnchor, h);
-  };
 
   // Momentum rows: K dx + (R(pbar + dp) - R(pbar)) + R = 0.
   Vector Kdx(assembly.dofMap()), fp(assembly.dofMap());
   W->apply(dx, Kdx);
-  setAnchors(1);
+  setAnchors(bricks, pbar0, dph, 1);
   ASSERT_TRUE(assembly.evaluate(u, &fp, nullptr));
-  setAnchors(0);
+  setAnchors(bricks, pbar0, dph, 0);
   Kdx.update(1.0, fp, 1.0);  // K dx + R(pbar + dp) - R(pbar) + R = K dx + R(pbar + dp)
   const double momentum = Kdx.norm2(), scale = fp.norm2() + f.norm2();
   ASSERT_GT(scale, 0);
   EXPECT_LT(momentum, 1e-9 * scale) << "|K dx - G dp + R| = " << momentum;
 
-  // Volume rows: (v(u + h dx) - v(u - h dx)) / 2h = V - v (v is cubic in x:
-  // the difference's error goes as h^2; seen 3.7e-5, 3.7e-7 of max |V - v| =
-  // 0.02 at h = 1e-3, 1e-4, the full step being long, far from equilibrium).
-  const double h = 1e-5;
-  std::vector<double> vp, vm;
-  for (double sign : {1.0, -1.0}) {
-    Vector us(u, Teuchos::Copy);
-    us.update(sign * h, dx, 1.0);
-    ASSERT_TRUE(assembly.evaluate(us, nullptr, nullptr));
-    (sign > 0 ? vp : vm) = copy(bricks.volume);
-  }
+  // Volume rows: G^T dx = V - v.
+  const std::vector<double> rate = volumeRate(assembly, u, dx);
   double worst = 0, largest = 0;
   for (size_t e = 0; e < V.size(); ++e) {
-    worst = std::max(worst, std::fabs((vp[e] - vm[e]) / (2 * h) - (V[e] - v0[e])));
+    worst = std::max(worst, std::fabs(rate[e] - (V[e] - v0[e])));
     largest = std::max(largest, std::fabs(V[e] - v0[e]));
   }
   double w = 0, l = 0;
@@ -195,17 +206,15 @@ TEST(PressureStep, PredictsTheVolumeErrorAfterNewton) {
   BoxProblem problem(boxScene(), 1.0);
   auto& [scene, mesh, assembly, newton, u, f] = problem;
   // (1 rank: the direct solver; 2 ranks: GMRES, and K~^-1 its preconditioner)
-  if (comm->getSize() == 1) EXPECT_FALSE(newton.iterative());
+  if (comm->getSize() == 1) {
+    EXPECT_FALSE(newton.iterative());
+  }
   BrickEffect& bricks = assembly.bricks();
   auto W = newton.matrix();
   ASSERT_TRUE(assembly.evaluate(u, &f, W.get()));
   const auto Kinv = newton.approximateInverse();  // of W as it is now
-  auto copy = [](const Kokkos::View<double*>& v) {
-    auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), v);
-    return std::vector<double>(h.data(), h.data() + h.size());
-  };
-  const std::vector<double> v0 = copy(bricks.volume), V = copy(bricks.referenceVolume);
-  const std::vector<double> pbar0 = copy(bricks.pressureAnchor);
+  const std::vector<double> v0 = hostCopy(bricks.volume), V = hostCopy(bricks.referenceVolume);
+  const std::vector<double> pbar0 = hostCopy(bricks.pressureAnchor);
   auto maxRelative = [&](const std::vector<double>& v) {
     double local = 0, global = 0;
     for (size_t e = 0; e < V.size(); ++e) local = std::max(local, std::fabs(v[e] - V[e]) / V[e]);
@@ -226,16 +235,11 @@ TEST(PressureStep, PredictsTheVolumeErrorAfterNewton) {
   EXPECT_GE(result.predictions, 1);
 
   // r_u = -(R(pbar + dp) + K dx), then Newton's du = K^-1 r_u (here K~^-1 r_u).
-  const std::vector<double> dph = copy(dmu[0]);
-  auto setAnchors = [&](double sgn) {
-    auto h = Kokkos::create_mirror_view(bricks.pressureAnchor);
-    for (size_t e = 0; e < h.extent(0); ++e) h(e) = pbar0[e] + sgn * dph[e];
-    Kokkos::deep_copy(bricks.pressureAnchor, h);
-  };
+  const std::vector<double> dph = hostCopy(dmu[0]);
   Vector ru(assembly.dofMap()), du(assembly.dofMap());
-  setAnchors(1);
+  setAnchors(bricks, pbar0, dph, 1);
   ASSERT_TRUE(assembly.evaluate(u, &ru, nullptr));
-  setAnchors(0);
+  setAnchors(bricks, pbar0, dph, 0);
   W->apply(dx, ru, Teuchos::NO_TRANS, -1.0, -1.0);
   Kinv(ru, du);
   {  // held dofs stay put
@@ -246,16 +250,9 @@ TEST(PressureStep, PredictsTheVolumeErrorAfterNewton) {
   // The volumes after both, to first order: v0 + G^T (dx + du).
   Vector move(dx, Teuchos::Copy);
   move.update(1.0, du, 1.0);
-  const double h = 1e-5;
-  std::vector<double> vp, vm;
-  for (double sign : {1.0, -1.0}) {
-    Vector us(u, Teuchos::Copy);
-    us.update(sign * h, move, 1.0);
-    ASSERT_TRUE(assembly.evaluate(us, nullptr, nullptr));
-    (sign > 0 ? vp : vm) = copy(bricks.volume);
-  }
-  std::vector<double> after(V.size()), stepOnly(V.size());
-  for (size_t e = 0; e < V.size(); ++e) after[e] = v0[e] + (vp[e] - vm[e]) / (2 * h);
+  const std::vector<double> rate = volumeRate(assembly, u, move);
+  std::vector<double> after(V.size());
+  for (size_t e = 0; e < V.size(); ++e) after[e] = v0[e] + rate[e];
   const double measured = maxRelative(after);
   std::printf("volume error: initial %.3e, left by the step %.3e, predicted after Newton %.3e, measured %.3e\n",
               initial, result.volumeResidual, result.volumePredicted, measured);
