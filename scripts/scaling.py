@@ -19,7 +19,7 @@ run made by hand may leave its CAPSTAN_NEWTON_LOG=1 output in OUT/<run>/run.log,
 from which the pressure steps' iterations are read if its summary lacks them.
 --steps N runs only the first N steps of each scene (the per-step and
 per-Newton figures stay comparable; the totals do not). The 8x G1 (550k
-DOFs, --g1 8) takes about 5.5 minutes on 2 ranks and 8 on 1 (docs/performance.md).
+DOFs, --g1 8) takes 4-13 minutes on 2 ranks and 6-20 on 1, by machine (docs/performance.md).
 "linear" counts every Krylov iteration: Newton's solves and the saddle-point
 pressure steps (split out in their own columns).
 """
