@@ -227,8 +227,13 @@ double PressureStep::predictedVolumeError(const Inverse& Kinv, const Vector& ru,
   return volumeError(*predictC_);
 }
 
+void PressureStep::measuredAfterNewton(double volumeError) {
+  if (lastPredicted_ > 0) missRatio_ = std::max(1.0, volumeError / lastPredicted_);
+  lastPredicted_ = 0;
+}
+
 PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv, const Vector& f, double tolerance,
-                                         double volumeTarget, double predictionTarget, int maxIterations, Vector& dx,
+                                         double volumeTarget, int maxIterations, Vector& dx,
                                          std::vector<Kokkos::View<double*>>& dmu) {
   Kokkos::Timer timer;
   fillRows();
@@ -252,16 +257,19 @@ PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv
   Block x = newBlock(), work = newBlock();
   const double beta0 = std::sqrt(dot(rhs, rhs));
   // Done early once the volume error predicted after the next Newton solve
-  // meets predictionTarget: the momentum residual the step leaves is Newton's
-  // to remove next, and that moves the volumes too (the Hertz roller, stopped
-  // on the step's own volume error at a 3e-2..3e-1 reduction, measured 10-40x
-  // it and never met the tolerance with the Laplacian Schur term). The
-  // prediction costs a K~^-1: it is checked only where the step's own volume
-  // error meets the target, and again only once the residual has halved.
+  // meets predictionTarget (measuredAfterNewton): the momentum residual the
+  // step leaves is Newton's to remove next, and that moves the volumes too
+  // (the Hertz roller, stopped on the step's own volume error at a 3e-2..3e-1
+  // reduction, measured 10-40x it and never met the tolerance with the
+  // Laplacian Schur term). The prediction costs a K~^-1: it is checked only
+  // where the step's own volume error meets the target, and again only once
+  // the residual has halved.
   // Otherwise done once the residual is reduced by `tolerance` and the volume
   // error left meets the target, or is far from it anyway. Going on past
   // `tolerance` is worth at most as many iterations again (+10): a target
   // below what round-off allows must not run to maxIterations.
+  const double predictionTarget = volumeTarget / missRatio_;
+  result.predictionTarget = predictionTarget;
   int reachedAt = -1;       // iterations when the residual first met `tolerance`
   double nextCheck = beta0;  // the prediction is checked again below this residual
   bool predictionMet = false;  // stays met through the cycle's end (its true residual is not checked again)
@@ -351,6 +359,7 @@ PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv
     if (!progress) break;  // stagnated: keep what there is (the loop checks the outcome)
   }
   result.reduction = beta0 > 0 ? beta / beta0 : 0.0;
+  lastPredicted_ = result.reduction < 1 ? result.volumePredicted : 0.0;  // a step without progress is not taken
   result.volumeResidual = volumeError(*r.c);
   // Held dofs stay where they are (K's identity rows would keep them at ~0
   // anyway; the preconditioner need not).

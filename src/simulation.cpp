@@ -267,14 +267,6 @@ class Run {
   std::unique_ptr<NewtonSolver> newton_;
   std::unique_ptr<PressureStep> pressureStep_;  // null with Solver/Pressure Update = Anderson
   std::vector<Kokkos::View<double*>> pressureStepDmu_;  // per effect: its multipliers' change in the step
-  // A step that stops early on its predicted volume error (PressureStep::solve)
-  // leaves the prediction to be checked against the volume error measured
-  // after the next Newton solve; the ratio (at least 1) divides the following
-  // steps' volume target. The prediction misses what K~^-1 misses of K^-1:
-  // G1 measured 1-3.5x it, the Hertz roller 5-20x, and without this ratio the
-  // Hertz roller hovered above its volume tolerance pass after pass.
-  double pressureStepPredicted_ = 0;  // the last step's prediction, until checked (0: none)
-  double pressureStepInflation_ = 1;  // measured / predicted, last checked
   RCP<FEMatrix> predictorMatrix_;
   RCP<Vector> u_;
   std::unique_ptr<FieldWriter> writer_;
@@ -495,8 +487,7 @@ bool Run::solveAt(double t0, double t, StepRecord& rec, std::string& failure) {
       Teuchos::reduceAll(*comm_, Teuchos::REDUCE_MAX, e->constraintViolation(), Teuchos::outArg(v));
       if (e.get() == &assembly_->bricks()) {
         rec.volumeChange = v, volumeMet = v <= e->constraintTolerance();
-        if (pressureStepPredicted_ > 0) pressureStepInflation_ = std::max(1.0, v / pressureStepPredicted_);
-        pressureStepPredicted_ = 0;
+        if (pressureStep_) pressureStep_->measuredAfterNewton(v);
       }
       if (!opt_.quiet && rank0_ && std::getenv("CAPSTAN_NEWTON_LOG"))
         std::printf("    %s: %.3e (tolerance %.1e)\n", e->constraintName().c_str(), v, e->constraintTolerance());
@@ -546,12 +537,11 @@ bool Run::saddlePointPressureStep(double t, Vector& f, StepRecord& rec) {
   // third of the volume tolerance (less by the ratio that the last such
   // prediction missed by), or to kPressureStepTolerance and the volume error
   // it leaves is a third of the tolerance, or still far off (PressureStep::solve).
-  const double tolerance = kPressureStepTolerance, volumeTarget = kPressureStepVolumeMargin * bricks.constraintTolerance(),
-               predictionTarget = volumeTarget / pressureStepInflation_;
+  const double tolerance = kPressureStepTolerance, volumeTarget = kPressureStepVolumeMargin * bricks.constraintTolerance();
   PressureStep::Result step;
   const auto stepStart = Clock::now();
   try {
-    step = pressureStep_->solve(*W, newton_->approximateInverse(), f, tolerance, volumeTarget, predictionTarget,
+    step = pressureStep_->solve(*W, newton_->approximateInverse(), f, tolerance, volumeTarget,
                                 scene_.solver.get<int>("Max Linear Iterations"), dx, pressureStepDmu_);
   } catch (const std::exception&) {  // e.g. a preconditioner that cannot be built: a plain pass
     return false;
@@ -561,10 +551,9 @@ bool Run::saddlePointPressureStep(double t, Vector& f, StepRecord& rec) {
   if (!opt_.quiet && rank0_ && std::getenv("CAPSTAN_NEWTON_LOG"))
     std::printf("    pressure step: %d GMRES iterations, residual reduced %.2e, volume error left %.2e "
                 "(stopped on the prediction after Newton %.2e, target %.2e, %d checks), %d contact rows; %.3f s\n",
-                step.iterations, step.reduction, step.volumeResidual, step.volumePredicted, predictionTarget,
+                step.iterations, step.reduction, step.volumeResidual, step.volumePredicted, step.predictionTarget,
                 step.predictions, step.contactRows, since(stepStart));
   if (!(step.reduction < 1)) return false;
-  pressureStepPredicted_ = step.volumePredicted;
   u_->update(1.0, dx, 1.0);
   assembly_->applyConstraints(*u_, t);
   // Each effect's multipliers move by their part of dmu (contact's back into

@@ -156,7 +156,7 @@ TEST(PressureStep, SolvesTheMixedNewtonSystem) {
   Vector dx(assembly.dofMap());
   std::vector<Kokkos::View<double*>> dmu;
   PressureStep step(assembly);
-  const auto result = step.solve(*W, newton.approximateInverse(), f, 1e-12, 0.0, 0.0, 500, dx, dmu);
+  const auto result = step.solve(*W, newton.approximateInverse(), f, 1e-12, 0.0, 500, dx, dmu);
   EXPECT_LT(result.reduction, 1e-11);
   ASSERT_EQ(dmu.size(), assembly.effects().size());
   const std::vector<double> dph = hostCopy(dmu[0]);
@@ -228,7 +228,7 @@ TEST(PressureStep, PredictsTheVolumeErrorAfterNewton) {
   Vector dx(assembly.dofMap());
   std::vector<Kokkos::View<double*>> dmu;
   PressureStep step(assembly);
-  const auto result = step.solve(*W, Kinv, f, 1e-12, target, target, 500, dx, dmu);
+  const auto result = step.solve(*W, Kinv, f, 1e-12, target, 500, dx, dmu);
   ASSERT_GT(result.volumePredicted, 0) << "the step must stop on its prediction";
   EXPECT_LE(result.volumePredicted, target);
   EXPECT_GT(result.reduction, 1e-10) << "stopped early";
@@ -283,7 +283,7 @@ TEST(PressureStep, SchurModelsGiveTheSameStep) {
     o.dx = rcp(new Vector(assembly.dofMap()));
     std::vector<Kokkos::View<double*>> dmu;
     PressureStep step(assembly, schur);
-    o.result = step.solve(*W, newton.approximateInverse(), f, 1e-12, 0.0, 0.0, 500, *o.dx, dmu);
+    o.result = step.solve(*W, newton.approximateInverse(), f, 1e-12, 0.0, 500, *o.dx, dmu);
     auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), dmu[0]);
     o.dp.assign(h.data(), h.data() + h.size());
     return o;
@@ -355,7 +355,7 @@ TEST(PressureStep, MovesContactMultipliersWithTheVolumes) {
   std::vector<Kokkos::View<double*>> dmu;
   PressureStep step(assembly);
   Vector dx(assembly.dofMap());
-  const auto result = step.solve(*W, newton.approximateInverse(), f, 1e-12, 0.0, 0.0, 500, dx, dmu);
+  const auto result = step.solve(*W, newton.approximateInverse(), f, 1e-12, 0.0, 500, dx, dmu);
   EXPECT_LT(result.reduction, 1e-11);
   EXPECT_GT(result.contactRows, 8) << "the capstan must press the top face";
   EXPECT_GT(step.rows(), long(result.contactRows));
