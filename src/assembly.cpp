@@ -4,6 +4,7 @@
 #include <Teuchos_CommHelpers.hpp>
 
 #include <algorithm>
+#include <limits>
 #include <set>
 
 namespace capstan {
@@ -308,6 +309,8 @@ void Assembly::findEntryOffsets() {
   const auto local = W->getLocalMatrixHost();
   const auto rowStart = local.graph.row_map;
   const auto entries = local.graph.entries;
+  if (entries.extent(0) > size_t(std::numeric_limits<int>::max()))
+    throw std::runtime_error("assembly: a rank's matrix has more than 2^31 entries; run on more ranks");
   auto find = [&](LO row, LO col) -> long {
     for (auto j = rowStart(row); j < rowStart(row + 1); ++j)
       if (entries(j) == col) return long(j);
@@ -322,14 +325,14 @@ void Assembly::findEntryOffsets() {
     }
     auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.dofs);
     const size_t n = dofs.extent(1);
-    Kokkos::View<long***, Kokkos::LayoutRight> offsets("entry offsets", dofs.extent(0), n, n);
+    Kokkos::View<int***, Kokkos::LayoutRight> offsets("entry offsets", dofs.extent(0), n, n);
     auto h = Kokkos::create_mirror_view(offsets);
     for (size_t e = 0; e < dofs.extent(0); ++e)
       for (size_t k = 0; k < n; ++k)
         for (size_t l = 0; l < n; ++l)
           h(e, k, l) = supportOf[dofs(e, k)] >= 0 || supportOf[dofs(e, l)] >= 0
                            ? -1
-                           : find(overlapLid(dofs(e, k)), columns_[i][e * n + l]);
+                           : int(find(overlapLid(dofs(e, k)), columns_[i][e * n + l]));
     Kokkos::deep_copy(offsets, h);
     entryOffsets_.push_back(offsets);
   }
@@ -560,7 +563,7 @@ bool Assembly::evaluate(const Vector& u, Vector* f, FEMatrix* W) {
             if (active.extent(0) && !active(e)) return;
             for (int k = 0; k < n; ++k)
               for (int l = 0; l < n; ++l) {
-                const long o = offsets(e, k, l);
+                const int o = offsets(e, k, l);
                 if (o < 0) continue;
                 if constexpr (kSerial) values(o) += K(e, k, l);
                 else Kokkos::atomic_add(&values(o), K(e, k, l));

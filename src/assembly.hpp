@@ -188,7 +188,9 @@ class Assembly {
   // Per effect: where each element-matrix entry (entity, k, l) lands in the
   // values of the local (owned plus shared) CRS matrix, -1 for entries of
   // constrained rows or columns. Found once, so assembly is a plain scatter.
-  std::vector<Kokkos::View<long***, Kokkos::LayoutRight>> entryOffsets_;
+  // 4-byte offsets: half the memory and traffic of 8-byte ones (G1 8x on 2
+  // ranks: 200 MB a rank); a rank's matrix holds fewer than 2^31 entries.
+  std::vector<Kokkos::View<int***, Kokkos::LayoutRight>> entryOffsets_;
   Kokkos::View<long*> constrainedDiagonal_;  // offsets of the owned constrained diagonals
   RCP<const Tpetra::Import<>> importer_;
   RCP<Vector> uOverlap_;

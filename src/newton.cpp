@@ -314,6 +314,9 @@ Teuchos::ParameterList stratimikosParameters(const Teuchos::ParameterList& solve
         ml.sublist("smoother: params").set("chebyshev: degree", 2);
       }
       ml.set("coarse: max size", 1500);
+      // Restriction applied as P^T instead of a stored R: the same iterations
+      // and time, 5% less memory (G1 4x: 654 against 690 MiB on 1 rank).
+      ml.set("transpose: use implicit", true);
       ml.set("Nullspace", nullspace);
       // On several ranks the coarse levels (below 2000 unknowns per rank) move
       // onto one rank, so that the coarsest solve is a serial KLU2: Amesos2's
