@@ -311,9 +311,9 @@ void Assembly::findEntryOffsets() {
   const auto entries = local.graph.entries;
   if (entries.extent(0) > size_t(std::numeric_limits<int>::max()))
     throw std::runtime_error("assembly: a rank's matrix has more than 2^31 entries; run on more ranks");
-  auto find = [&](LO row, LO col) -> long {
+  auto find = [&](LO row, LO col) -> int {
     for (auto j = rowStart(row); j < rowStart(row + 1); ++j)
-      if (entries(j) == col) return long(j);
+      if (entries(j) == col) return int(j);
     throw std::logic_error("assembly: an element entry is missing from the matrix graph");
   };
   const auto& supportOf = constraints_.supportOf;
@@ -332,14 +332,14 @@ void Assembly::findEntryOffsets() {
         for (size_t l = 0; l < n; ++l)
           h(e, k, l) = supportOf[dofs(e, k)] >= 0 || supportOf[dofs(e, l)] >= 0
                            ? -1
-                           : int(find(overlapLid(dofs(e, k)), columns_[i][e * n + l]));
+                           : find(overlapLid(dofs(e, k)), columns_[i][e * n + l]);
     Kokkos::deep_copy(offsets, h);
     entryOffsets_.push_back(offsets);
   }
-  std::vector<long> diagonal;
+  std::vector<int> diagonal;
   for (LO d = 0; d < LO(ownedDofMap_->getNodeNumElements()); ++d)
     if (supportOf[assemblyDof(d)] >= 0) diagonal.push_back(find(d, columnOf_[assemblyDof(d)]));
-  constrainedDiagonal_ = Kokkos::View<long*>("constrained diagonal", diagonal.size());
+  constrainedDiagonal_ = Kokkos::View<int*>("constrained diagonal", diagonal.size());
   auto hd = Kokkos::create_mirror_view(constrainedDiagonal_);
   for (size_t j = 0; j < diagonal.size(); ++j) hd(j) = diagonal[j];
   Kokkos::deep_copy(constrainedDiagonal_, hd);

@@ -191,7 +191,7 @@ class Assembly {
   // 4-byte offsets: half the memory and traffic of 8-byte ones (G1 8x on 2
   // ranks: 200 MB a rank); a rank's matrix holds fewer than 2^31 entries.
   std::vector<Kokkos::View<int***, Kokkos::LayoutRight>> entryOffsets_;
-  Kokkos::View<long*> constrainedDiagonal_;  // offsets of the owned constrained diagonals
+  Kokkos::View<int*> constrainedDiagonal_;  // offsets of the owned constrained diagonals
   RCP<const Tpetra::Import<>> importer_;
   RCP<Vector> uOverlap_;
   RCP<Tpetra::FEMultiVector<>> residual_;

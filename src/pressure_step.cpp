@@ -331,8 +331,8 @@ PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv
       res = std::fabs(s[k + 1]);
       // The volume error in GMRES's residual b - A x_k = s_{k+1} u_k, where
       // u_k = V_{k+1} Q_k^T e_{k+1} (Q_k: the rotations so far) follows
-      // u_k = -sn_k u_{k-1} + cs_k v_{k+1}, u_{-1} = v_0: one update of its
-      // constraint block per iteration.
+      // u_k = -sn_k u_{k-1} + cs_k v_{k+1}, u_{-1} = v_0: one update of each
+      // block per iteration (the position block for the prediction).
       if (volumeTarget > 0) {
         residualC_->update(cs[k], *basis_[k + 1].c, -sn[k]);
         residualU_->update(cs[k], *basis_[k + 1].u, -sn[k]);
