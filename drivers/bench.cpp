@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "assembly.hpp"
+#include "huge_pages.hpp"
 #include "kernels/brick.hpp"
 #include "kernels/contact.hpp"
 #include "kernels/friction.hpp"
@@ -110,6 +111,7 @@ double triadBandwidth(long n, double seconds) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  capstan::reexecWithHugePages(argv);  // as capstan itself runs (src/huge_pages.hpp)
   Tpetra::ScopeGuard scope(&argc, &argv);
   const int n = argc > 1 ? std::atoi(argv[1]) : 20;
   auto comm = Tpetra::getDefaultComm();
@@ -220,7 +222,8 @@ int main(int argc, char** argv) {
       std::printf("| %s | %.3e | %.0f | %.2f | %.1f%% |\n", what, evals, flops, evals * flops * 1e-9,
                   100 * evals * flops / peak);
     };
-    std::printf("bricks: %.0f on this rank (%d^3 box); FMA peak of this core: %.1f GFLOP/s\n\n", ne, n, peak * 1e-9);
+    std::printf("bricks: %.0f on this rank (%d^3 box); FMA peak of this core: %.1f GFLOP/s; huge pages: %s\n\n", ne, n,
+                peak * 1e-9, capstan::hugePagesRequested() ? "on" : "off");
     std::printf("| kernel | evaluations/s | flops/evaluation | GFLOP/s | of peak |\n|---|---|---|---|---|\n");
     row("brick residual + tangent", brickTangent, kBrickFlopsTangent);
     row("brick residual only", brickResidual, kBrickFlopsResidual);

@@ -910,6 +910,17 @@ void Run::writeSummary(bool converged, const std::string& failure) {
   const double mine = double(usage.ru_maxrss) / 1024.0;
   std::vector<double> peakMiB(comm_->getSize());
   Teuchos::gatherAll(*comm_, 1, &mine, int(peakMiB.size()), peakMiB.data());
+  // How much of the heap sits in transparent huge pages now (src/huge_pages.hpp).
+  double hugeMine = 0;
+  {
+    std::ifstream smaps("/proc/self/smaps_rollup");
+    std::string key;
+    double kib;
+    while (smaps >> key)
+      if (key == "AnonHugePages:" && smaps >> kib) hugeMine = kib / 1024.0;
+  }
+  std::vector<double> hugeMiB(comm_->getSize());
+  Teuchos::gatherAll(*comm_, 1, &hugeMine, int(hugeMiB.size()), hugeMiB.data());
   if (!rank0_) return;
   using json::Object;
   auto vec = [](const std::array<double, 3>& v) { return json::array({v[0], v[1], v[2]}); };
@@ -985,7 +996,8 @@ void Run::writeSummary(bool converged, const std::string& failure) {
       .add("preconditioner_setup", json::number(newton_->preconditionerSeconds() + timingOffset_[4]));
   Object memory;
   memory.add("peak_rss_mib", json::array(peakMiB))
-      .add("peak_rss_mib_max", json::number(*std::max_element(peakMiB.begin(), peakMiB.end())));
+      .add("peak_rss_mib_max", json::number(*std::max_element(peakMiB.begin(), peakMiB.end())))
+      .add("huge_pages_mib", json::array(hugeMiB));
   Object mesh;
   mesh.add("nodes", json::number(long(mesh_.numGlobalNodes)))
       .add("elements", json::number(long(mesh_.numGlobalElements)))

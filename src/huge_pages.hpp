@@ -1,0 +1,43 @@
+// Transparent huge pages for the whole heap: the programs call
+// reexecWithHugePages(argv) first thing in main().
+//
+// Why: on the virtual machines capstan runs on, a TLB miss costs a nested
+// page walk, and one assembly streams through every element matrix, its CRS
+// offsets and the matrix values (G1 4x: ~200 MB in 4 KiB pages). With huge
+// pages the brick kernels ran 2-4x faster and G1 4x 30% faster in all, for
+// 1% more memory (docs/performance.md, "Huge pages").
+//
+// How: Debian's kernels hand out huge pages only where a program asks
+// (transparent_hugepage = madvise); glibc's malloc asks for every heap and
+// large block when the tunable glibc.malloc.hugetlb=1 is set, and it reads
+// GLIBC_TUNABLES only when a program starts. So the program runs itself
+// again, once, with the tunable added. A GLIBC_TUNABLES that already names
+// glibc.malloc.hugetlb is left as it is (=0 turns huge pages off). A glibc
+// without the tunable (before 2.35) ignores it. Must run before MPI starts.
+#pragma once
+
+#include <unistd.h>
+
+#include <cstdlib>
+#include <cstring>
+#include <string>
+
+namespace capstan {
+
+inline void reexecWithHugePages(char** argv) {
+  const char* tunables = std::getenv("GLIBC_TUNABLES");
+  if (tunables && std::strstr(tunables, "glibc.malloc.hugetlb")) return;
+  const std::string value =
+      tunables && *tunables ? std::string(tunables) + ":glibc.malloc.hugetlb=1" : "glibc.malloc.hugetlb=1";
+  if (setenv("GLIBC_TUNABLES", value.c_str(), 1) != 0) return;
+  execv("/proc/self/exe", argv);  // returns only if it failed: run on without huge pages
+}
+
+// Whether this process asked for huge pages (for the programs' reports).
+inline bool hugePagesRequested() {
+  const char* tunables = std::getenv("GLIBC_TUNABLES");
+  const char* hugetlb = tunables ? std::strstr(tunables, "glibc.malloc.hugetlb=") : nullptr;
+  return hugetlb && hugetlb[std::strlen("glibc.malloc.hugetlb=")] != '0';
+}
+
+}  // namespace capstan
