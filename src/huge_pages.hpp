@@ -4,8 +4,9 @@
 // Why: on the virtual machines capstan runs on, a TLB miss costs a nested
 // page walk, and one assembly streams through every element matrix, its CRS
 // offsets and the matrix values (G1 4x: ~200 MB in 4 KiB pages). With huge
-// pages the brick kernels ran 2-4x faster and G1 4x 30% faster in all, for
-// 1% more memory (docs/performance.md, "Huge pages").
+// pages G1 4x's assembly took 3-5x less time and the whole run 1.45x less on
+// 1 rank, and G1 8x 1.31x less on 2 ranks, for under 2% more memory
+// (docs/performance.md, "Huge pages").
 //
 // How: Debian's kernels hand out huge pages only where a program asks
 // (transparent_hugepage = madvise); glibc's malloc asks for every heap and
