@@ -25,11 +25,13 @@
 
 namespace capstan {
 
+inline constexpr const char* kHugePagesTunable = "glibc.malloc.hugetlb";
+
 inline void reexecWithHugePages(char** argv) {
   const char* tunables = std::getenv("GLIBC_TUNABLES");
-  if (tunables && std::strstr(tunables, "glibc.malloc.hugetlb")) return;
-  const std::string value =
-      tunables && *tunables ? std::string(tunables) + ":glibc.malloc.hugetlb=1" : "glibc.malloc.hugetlb=1";
+  if (tunables && std::strstr(tunables, kHugePagesTunable)) return;
+  const std::string on = std::string(kHugePagesTunable) + "=1";
+  const std::string value = tunables && *tunables ? std::string(tunables) + ":" + on : on;
   if (setenv("GLIBC_TUNABLES", value.c_str(), 1) != 0) return;
   execv("/proc/self/exe", argv);  // returns only if it failed: run on without huge pages
 }
@@ -37,8 +39,8 @@ inline void reexecWithHugePages(char** argv) {
 // Whether this process asked for huge pages (for the programs' reports).
 inline bool hugePagesRequested() {
   const char* tunables = std::getenv("GLIBC_TUNABLES");
-  const char* hugetlb = tunables ? std::strstr(tunables, "glibc.malloc.hugetlb=") : nullptr;
-  return hugetlb && hugetlb[std::strlen("glibc.malloc.hugetlb=")] != '0';
+  const char* setting = tunables ? std::strstr(tunables, kHugePagesTunable) : nullptr;
+  return setting && setting[std::strlen(kHugePagesTunable)] == '=' && setting[std::strlen(kHugePagesTunable) + 1] != '0';
 }
 
 }  // namespace capstan
