@@ -164,12 +164,20 @@ MPI_Comm rawComm(const RCP<const Comm>& comm) {
   return mpi.is_null() ? MPI_COMM_SELF : (*mpi->getRawMpiComm())();
 }
 
-// Rank 0: part[e] for every element (METIS k-way on the dual graph).
-std::vector<idx_t> partitionElements(const MeshGenerator& gen, int nparts) {
+// Equal runs of consecutive element ids.
+std::vector<idx_t> consecutiveRuns(GO ne, int nparts) {
+  std::vector<idx_t> part(ne);
+  for (GO e = 0; e < ne; ++e) part[e] = idx_t(e * nparts / ne);
+  return part;
+}
+
+// Rank 0: part[e] for every element.
+std::vector<idx_t> partitionElements(const MeshGenerator& gen, int nparts, Partition partition) {
   const GO ne = gen.numElements();
-  std::vector<idx_t> part(ne, 0);
-  if (nparts == 1) return part;
+  if (nparts == 1) return std::vector<idx_t>(ne, 0);
   if (ne < nparts) throw std::runtime_error("mesh: fewer elements than MPI ranks");
+  if (partition == Partition::Slabs) return consecutiveRuns(ne, nparts);
+  std::vector<idx_t> part(ne, 0);
   std::vector<idx_t> xadj(ne + 1, 0), adjncy;
   for (GO e = 0; e < ne; ++e) {
     for (GO nb : gen.faceNeighbours(e)) adjncy.push_back(idx_t(nb));
@@ -183,23 +191,35 @@ std::vector<idx_t> partitionElements(const MeshGenerator& gen, int nparts) {
                                          nullptr, &np, nullptr, nullptr, options, &objval,
                                          part.data());
   if (status != METIS_OK) throw std::runtime_error("mesh: METIS partitioning failed");
-  // METIS may leave a part empty on tiny meshes: then fall back to blocks of
+  // METIS may leave a part empty on tiny meshes: then fall back to runs of
   // consecutive elements, so every rank has work.
   std::vector<GO> size(nparts, 0);
   for (idx_t p : part) ++size[p];
-  if (*std::min_element(size.begin(), size.end()) == 0)
-    for (GO e = 0; e < ne; ++e) part[e] = idx_t(e * nparts / ne);
+  if (*std::min_element(size.begin(), size.end()) == 0) return consecutiveRuns(ne, nparts);
   return part;
 }
 
-// Each rank receives the global ids of its elements, in increasing order.
-std::vector<GO> scatterElements(const MeshGenerator& gen, const RCP<const Comm>& comm) {
+// Element faces whose two elements lie on different ranks.
+GO cutFaces(const MeshGenerator& gen, const std::vector<idx_t>& part) {
+  GO cut = 0;
+  for (GO e = 0; e < GO(part.size()); ++e)
+    for (GO nb : gen.faceNeighbours(e))
+      if (nb > e && part[nb] != part[e]) ++cut;
+  return cut;
+}
+
+// Each rank receives the global ids of its elements, in increasing order,
+// and the number of faces cut.
+std::vector<GO> scatterElements(const MeshGenerator& gen, const RCP<const Comm>& comm, Partition partition,
+                                GO& cutFacesOut) {
   const int nranks = comm->getSize(), rank = comm->getRank();
   MPI_Comm mc = rawComm(comm);
   std::vector<long long> sendbuf;
   std::vector<int> counts(nranks, 0), displs(nranks, 0);
+  long long cut = 0;
   if (rank == 0) {
-    const auto part = partitionElements(gen, nranks);
+    const auto part = partitionElements(gen, nranks, partition);
+    cut = nranks > 1 ? cutFaces(gen, part) : 0;
     for (idx_t p : part) ++counts[p];
     std::partial_sum(counts.begin(), counts.end() - 1, displs.begin() + 1);
     sendbuf.resize(part.size());
@@ -211,6 +231,8 @@ std::vector<GO> scatterElements(const MeshGenerator& gen, const RCP<const Comm>&
   std::vector<long long> recv(mine);
   MPI_Scatterv(sendbuf.data(), counts.data(), displs.data(), MPI_LONG_LONG, recv.data(), mine,
                MPI_LONG_LONG, 0, mc);
+  MPI_Bcast(&cut, 1, MPI_LONG_LONG, 0, mc);
+  cutFacesOut = GO(cut);
   return std::vector<GO>(recv.begin(), recv.end());
 }
 
@@ -224,13 +246,13 @@ RCP<const Map> dofMap(const std::vector<GO>& nodes, const RCP<const Comm>& comm)
 
 }  // namespace
 
-Mesh distributeMesh(const MeshGenerator& gen, const RCP<const Comm>& comm) {
+Mesh distributeMesh(const MeshGenerator& gen, const RCP<const Comm>& comm, Partition partition) {
   Mesh m;
   m.comm = comm;
   m.numGlobalNodes = gen.numNodes();
   m.numGlobalElements = gen.numElements();
   m.faceNames = gen.faceNames();
-  m.elementGids = scatterElements(gen, comm);
+  m.elementGids = scatterElements(gen, comm, partition, m.numCutFaces);
 
   // Nodes this rank touches; ownership decided by Tpetra (one owner per node).
   std::vector<GO> touched;

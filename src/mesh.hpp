@@ -34,6 +34,16 @@ class MeshGenerator {
   virtual std::vector<GO> faceNeighbours(GO element) const = 0;
 };
 
+// How elements are split over the ranks.
+// - Metis: METIS k-way on the dual graph (fewest faces cut, any mesh).
+// - Slabs: equal runs of consecutive element ids. Both generators number
+//   their cells with the third index slowest, so the runs are slabs across
+//   it (a box's z, an annulus's axis). Each rank's nodes are then a run of
+//   the one-rank numbering, and MueLu's aggregation, which walks the nodes in
+//   that order, makes nearly the aggregates it makes on one rank
+//   (docs/performance.md, "Partitions").
+enum class Partition { Metis, Slabs };
+
 // Structured box: Cells = {nx, ny, nz} bricks over [Min, Max]; faces xmin..zmax.
 class BoxGenerator : public MeshGenerator {
  public:
@@ -98,6 +108,7 @@ struct Mesh {
   size_t numOwnedNodes = 0;
   std::vector<double> X;             // 3 per overlapped node: reference coordinates
   std::vector<GO> elementGids;       // every element lives on exactly one rank
+  GO numCutFaces = 0;                // element faces between two ranks (all ranks)
   std::vector<int> connectivity;     // 8 overlapped node ids per element
   std::map<std::string, std::vector<int>> faces;  // 4 overlapped node ids per quad
 
@@ -110,6 +121,7 @@ struct Mesh {
 };
 
 // Partitions the generator's elements over comm and builds this rank's part.
-Mesh distributeMesh(const MeshGenerator& generator, const RCP<const Comm>& comm);
+Mesh distributeMesh(const MeshGenerator& generator, const RCP<const Comm>& comm,
+                    Partition partition = Partition::Metis);
 
 }  // namespace capstan

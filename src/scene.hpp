@@ -12,6 +12,7 @@ namespace capstan {
 
 struct MeshSpec {
   std::string type;  // Box | Annulus
+  std::string partition = "METIS";  // METIS | Slabs (over the MPI ranks)
   std::array<double, 3> min{}, max{};  // Box: its corners; Annulus: its bounding box
   std::array<int, 3> cells{};          // Box: x, y, z; Annulus: radial, circumferential, axial
   // Annulus: axis point at the zmin end (axis along +z), radii, length.

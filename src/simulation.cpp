@@ -1002,7 +1002,9 @@ void Run::writeSummary(bool converged, const std::string& failure) {
   mesh.add("nodes", json::number(long(mesh_.numGlobalNodes)))
       .add("elements", json::number(long(mesh_.numGlobalElements)))
       .add("dofs", json::number(long(3 * mesh_.numGlobalNodes)))
-      .add("contact_faces", json::number(numContactFaces_));
+      .add("contact_faces", json::number(numContactFaces_))
+      .add("partition", json::string(scene_.mesh.partition))
+      .add("cut_faces", json::number(long(mesh_.numCutFaces)));
   Object top;
   top.add("title", json::string(scene_.title)).add("scene", json::string(scene_.file))
       .add("version", json::string(CAPSTAN_VERSION))
@@ -1336,7 +1338,7 @@ int Run::execute() {
                                                     m.outerCellRatio, m.fineSector);
   else
     generator_ = std::make_unique<BoxGenerator>(m.min, m.max, m.cells);
-  mesh_ = distributeMesh(*generator_, comm_);
+  mesh_ = distributeMesh(*generator_, comm_, m.partition == "Slabs" ? Partition::Slabs : Partition::Metis);
   assembly_ = std::make_unique<Assembly>(mesh_, scene_);
   try {
     newton_ = std::make_unique<NewtonSolver>(*assembly_, scene_.solver);

@@ -1,8 +1,10 @@
 // Mesh generators: the annulus (pinch-roller coating) is a closed ring of
 // bricks with positive Jacobians, the right volume, outward-facing boundary
-// faces and a symmetric dual graph; it distributes like the box.
+// faces and a symmetric dual graph; it distributes like the box. Both
+// partitions (METIS, slabs) put their cuts where they should and count them.
 #include <gtest/gtest.h>
 
+#include <Teuchos_CommHelpers.hpp>
 #include <Tpetra_Core.hpp>
 
 #include <algorithm>
@@ -154,4 +156,70 @@ TEST(Annulus, DistributesWithFaces) {
   // Inner-face nodes all lie on the inner radius.
   for (int n : mesh.faceNodes("inner"))
     EXPECT_NEAR(std::hypot(mesh.X[3 * n], mesh.X[3 * n + 1]), 1.0, 1e-12);
+}
+
+// ---------------------------------------------------------------- partitions
+namespace {
+
+// Faces between this rank's elements and other ranks', summed over ranks and
+// halved: an independent count of the faces the partition cuts.
+GO countCutFaces(const MeshGenerator& gen, const Mesh& mesh) {
+  const std::set<GO> mine(mesh.elementGids.begin(), mesh.elementGids.end());
+  long long local = 0, global = 0;
+  for (GO e : mesh.elementGids)
+    for (GO nb : gen.faceNeighbours(e))
+      if (!mine.count(nb)) ++local;
+  Teuchos::reduceAll(*mesh.comm, Teuchos::REDUCE_SUM, local, Teuchos::outArg(global));
+  return GO(global / 2);
+}
+
+}  // namespace
+
+TEST(Partition, MetisCutsFewFacesAndCountsThem) {
+  BoxGenerator gen({0, 0, 0}, {6, 2, 4}, {12, 4, 8});
+  const Mesh mesh = distributeMesh(gen, Tpetra::getDefaultComm(), Partition::Metis);
+  const int ranks = mesh.comm->getSize();
+  EXPECT_EQ(mesh.numCutFaces, countCutFaces(gen, mesh));
+  if (ranks == 1) EXPECT_EQ(mesh.numCutFaces, 0);
+  // Two ranks: no worse than the best plane (across x: 4 x 8 faces) by much.
+  if (ranks == 2) EXPECT_LE(mesh.numCutFaces, 2 * 4 * 8);
+}
+
+TEST(Partition, BoxSlabsAreRunsAcrossZ) {
+  const int nx = 6, ny = 4, nz = 8;
+  BoxGenerator gen({0, 0, 0}, {3, 2, 4}, {nx, ny, nz});
+  const Mesh mesh = distributeMesh(gen, Tpetra::getDefaultComm(), Partition::Slabs);
+  const int ranks = mesh.comm->getSize(), rank = mesh.comm->getRank();
+  const GO ne = GO(nx) * ny * nz;
+  // This rank holds the run [rank ne / ranks, (rank + 1) ne / ranks).
+  ASSERT_EQ(GO(mesh.elementGids.size()), (rank + 1) * ne / ranks - rank * ne / ranks);
+  for (size_t i = 0; i < mesh.elementGids.size(); ++i) EXPECT_EQ(mesh.elementGids[i], rank * ne / ranks + GO(i));
+  // 8 layers over 1 or 2 ranks: every slab is whole layers, z in [z0, z0 + 4 / ranks].
+  const double z0 = 4.0 * rank / ranks, z1 = 4.0 * (rank + 1) / ranks;
+  for (size_t n = 0; n < mesh.numOverlapNodes(); ++n) {
+    EXPECT_GE(mesh.X[3 * n + 2], z0 - 1e-12);
+    EXPECT_LE(mesh.X[3 * n + 2], z1 + 1e-12);
+  }
+  // Each plane between slabs cuts nx x ny faces.
+  EXPECT_EQ(mesh.numCutFaces, GO(ranks - 1) * nx * ny);
+  EXPECT_EQ(mesh.numCutFaces, countCutFaces(gen, mesh));
+  // Every node is owned once.
+  long long owned = long(mesh.numOwnedNodes), total = 0;
+  Teuchos::reduceAll(*mesh.comm, Teuchos::REDUCE_SUM, owned, Teuchos::outArg(total));
+  EXPECT_EQ(total, (nx + 1) * (ny + 1) * (nz + 1));
+}
+
+TEST(Partition, AnnulusSlabsAreRunsAlongTheAxis) {
+  const double length = 2.0;
+  AnnulusGenerator gen({0, 0, 0}, 1.0, 2.0, length, {2, 12, 4});
+  const Mesh mesh = distributeMesh(gen, Tpetra::getDefaultComm(), Partition::Slabs);
+  const int ranks = mesh.comm->getSize(), rank = mesh.comm->getRank();
+  const double z0 = length * rank / ranks, z1 = length * (rank + 1) / ranks;
+  for (size_t n = 0; n < mesh.numOverlapNodes(); ++n) {
+    EXPECT_GE(mesh.X[3 * n + 2], z0 - 1e-12);
+    EXPECT_LE(mesh.X[3 * n + 2], z1 + 1e-12);
+  }
+  // The cut is one ring of 2 x 12 faces per plane between slabs.
+  EXPECT_EQ(mesh.numCutFaces, GO(ranks - 1) * 2 * 12);
+  EXPECT_EQ(mesh.numCutFaces, countCutFaces(gen, mesh));
 }
