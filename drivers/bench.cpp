@@ -27,7 +27,7 @@
 #include <vector>
 
 #include "assembly.hpp"
-#include "huge_pages.hpp"
+#include "heap_tunables.hpp"
 #include "kernels/brick.hpp"
 #include "kernels/contact.hpp"
 #include "kernels/friction.hpp"
@@ -111,7 +111,7 @@ double triadBandwidth(long n, double seconds) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  capstan::reexecWithHugePages(argv);  // as capstan itself runs (src/huge_pages.hpp)
+  capstan::reexecWithHeapTunables(argv);  // as capstan itself runs (src/heap_tunables.hpp)
   Tpetra::ScopeGuard scope(&argc, &argv);
   const int n = argc > 1 ? std::atoi(argv[1]) : 20;
   auto comm = Tpetra::getDefaultComm();

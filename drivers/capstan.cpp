@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "errors.hpp"
-#include "huge_pages.hpp"
+#include "heap_tunables.hpp"
 #include "scene.hpp"
 #include "simulation.hpp"
 
@@ -70,7 +70,7 @@ bool parse(int argc, char** argv, Args& a, std::string& error) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  capstan::reexecWithHugePages(argv);  // before MPI starts (src/huge_pages.hpp)
+  capstan::reexecWithHeapTunables(argv);  // before MPI starts (src/heap_tunables.hpp)
   Tpetra::ScopeGuard tpetra(&argc, &argv);
   auto comm = Tpetra::getDefaultComm();
   const bool rank0 = comm->getRank() == 0;

@@ -904,23 +904,26 @@ void Run::writeHistory() {
 
 void Run::writeSummary(bool converged, const std::string& failure) {
   const StateFigures s = figures();
-  // Peak resident memory of every rank (Linux reports ru_maxrss in KiB).
+  // Per rank: peak resident memory (Linux reports ru_maxrss in KiB), memory in
+  // transparent huge pages now, and page faults so far (src/heap_tunables.hpp).
   struct rusage usage;
   getrusage(RUSAGE_SELF, &usage);
-  const double mine = double(usage.ru_maxrss) / 1024.0;
-  std::vector<double> peakMiB(comm_->getSize());
-  Teuchos::gatherAll(*comm_, 1, &mine, int(peakMiB.size()), peakMiB.data());
-  // How much of the heap sits in transparent huge pages now (src/huge_pages.hpp).
-  double hugeMine = 0;
+  double mine[3] = {double(usage.ru_maxrss) / 1024.0, 0, double(usage.ru_minflt)};
   {
     std::ifstream smaps("/proc/self/smaps_rollup");
     std::string key;
     double kib;
     while (smaps >> key)
-      if (key == "AnonHugePages:" && smaps >> kib) hugeMine = kib / 1024.0;
+      if (key == "AnonHugePages:" && smaps >> kib) mine[1] = kib / 1024.0;
   }
-  std::vector<double> hugeMiB(comm_->getSize());
-  Teuchos::gatherAll(*comm_, 1, &hugeMine, int(hugeMiB.size()), hugeMiB.data());
+  const int ranks = comm_->getSize();
+  std::vector<double> all(3 * ranks), peakMiB(ranks), hugeMiB(ranks), faults(ranks);
+  Teuchos::gatherAll(*comm_, 3, mine, 3 * ranks, all.data());
+  for (int r = 0; r < ranks; ++r) {
+    peakMiB[r] = all[3 * r];
+    hugeMiB[r] = all[3 * r + 1];
+    faults[r] = all[3 * r + 2];
+  }
   if (!rank0_) return;
   using json::Object;
   auto vec = [](const std::array<double, 3>& v) { return json::array({v[0], v[1], v[2]}); };
@@ -997,7 +1000,8 @@ void Run::writeSummary(bool converged, const std::string& failure) {
   Object memory;
   memory.add("peak_rss_mib", json::array(peakMiB))
       .add("peak_rss_mib_max", json::number(*std::max_element(peakMiB.begin(), peakMiB.end())))
-      .add("huge_pages_mib", json::array(hugeMiB));
+      .add("huge_pages_mib", json::array(hugeMiB))
+      .add("page_faults", json::array(faults));
   Object mesh;
   mesh.add("nodes", json::number(long(mesh_.numGlobalNodes)))
       .add("elements", json::number(long(mesh_.numGlobalElements)))
