@@ -1241,7 +1241,7 @@ void Run::restore(Restart& r) {
     const auto cores = in.getVector<double>();
     if (gids.size() != mesh_.numOwnedNodes || u.size() != 3 * gids.size())
       throw std::runtime_error("holds " + std::to_string(gids.size()) + " nodes, this rank owns " +
-                               std::to_string(mesh_.numOwnedNodes) + " (another mesh or partition)");
+                               std::to_string(mesh_.numOwnedNodes) + " (another mesh, or another Mesh/Partition)");
     std::map<long long, size_t> owned;
     for (size_t n = 0; n < mesh_.numOwnedNodes; ++n) owned[mesh_.nodeGids[n]] = n;
     auto ud = u_->getDataNonConst();

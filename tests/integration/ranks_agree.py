@@ -10,8 +10,11 @@ augmented Lagrangian), H1 (tanh friction) and H5 (Coulomb friction) on 1 and 2 r
     relative to the largest magnitude of their kind;
   * fields.h5: the final displacement of every node, matched by its reference
     coordinates (node order depends on the partition), agrees to 1e-8 x max |u|.
-Then G1 with Solver/Linear Solver = Direct on 2 ranks: capstan notes that it uses GMRES
-instead (KLU2 through Amesos2 fails on several ranks) and matches the 1-rank forces.
+METIS splits the 2-rank runs by default (summary.json mesh.partition; mesh.cut_faces is 0 on
+1 rank, above 0 on 2). Then G1 with Solver/Linear Solver = Direct on 2 ranks: capstan notes
+that it uses GMRES instead (KLU2 through Amesos2 fails on several ranks) and matches the
+1-rank forces. And G1 with Mesh/Partition = Slabs on 2 ranks: 56 faces cut (one plane of
+14 x 4), every summary figure as on 1 rank.
 """
 import os
 import sys
@@ -42,7 +45,10 @@ for name in ("uniaxial.xml", "shear.xml", "seed/g1.xml", "seed/h1.xml", "seed/h5
     serial[name] = s1
     T.check(len(s1["steps"]) == len(s2["steps"]),
             f"{name}: {len(s1['steps'])} steps on 1 rank, {len(s2['steps'])} on 2")
-    T.check(s1["mesh"] == s2["mesh"], f"{name}: mesh sizes {s1['mesh']} vs {s2['mesh']}")
+    sizes = ("nodes", "elements", "dofs", "contact_faces")
+    T.check(all(s1["mesh"][k] == s2["mesh"][k] for k in sizes), f"{name}: mesh sizes {s1['mesh']} vs {s2['mesh']}")
+    T.check(s1["mesh"]["cut_faces"] == 0 < s2["mesh"]["cut_faces"] and s2["mesh"]["partition"] == "METIS",
+            f"{name}: METIS by default, faces cut: 1 rank {s1['mesh']['cut_faces']}, 2 ranks {s2['mesh']['cut_faces']}")
     g1, g2 = summary_figures(s1), summary_figures(s2)
     for group in g1:
         missing = set(g1[group]) ^ set(g2[group])
@@ -85,5 +91,19 @@ if s is not None and "seed/g1.xml" in serial:
     T.check(worst <= TOL, f"G1, Direct on 2 ranks: forces agree with 1 rank: worst {worst:.2e} ({k}) (<= {TOL:g})")
 else:
     T.check(False, "G1, Direct on 2 ranks: no summary.json (or no 1-rank run to compare with)")
+
+# Mesh/Partition = Slabs on 2 ranks: G1's 6 layers of 14 x 4 cells in two slabs of 3,
+# one plane of 56 faces between them; the same answer as 1 rank.
+p, s, out = T.run_scene(g1, "g1-slabs-2", sets=["Mesh/Partition=Slabs", "Output/Write Fields=false"], ranks=2)
+if s is not None and "seed/g1.xml" in serial:
+    T.check(s["converged"] is True, f"G1, slabs on 2 ranks: converged = {s['converged']} ({s['failure']!r})")
+    T.conforms(out, g1)
+    T.check(s["mesh"]["partition"] == "Slabs" and s["mesh"]["cut_faces"] == 14 * 4,
+            f"G1, slabs on 2 ranks: mesh.partition {s['mesh']['partition']!r}, cut_faces {s['mesh']['cut_faces']} (56)")
+    for group, ref in summary_figures(serial["seed/g1.xml"]).items():
+        worst, k, scale = worst_difference(ref, summary_figures(s)[group])
+        T.check(worst <= TOL, f"G1, slabs on 2 ranks: {group} agrees with 1 rank: worst {worst:.2e} ({k}) (<= {TOL:g})")
+else:
+    T.check(False, "G1, slabs on 2 ranks: no summary.json (or no 1-rank run to compare with)")
 
 T.finish()
