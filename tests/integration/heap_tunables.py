@@ -45,18 +45,35 @@ except (OSError, IndexError):
     pass
 print(f"  kernel transparent huge pages: {mode}")
 
+
+def run(label, tunables, ranks=1, extra=()):
+    """One run with GLIBC_TUNABLES set as given; checks that it converged and conforms."""
+    p, s, out = T.run_scene(scene, label.replace(" ", "-").replace(",", "").replace("'", ""),
+                            sets=sets + list(extra), ranks=ranks, env={"GLIBC_TUNABLES": tunables})
+    if s is None:
+        T.check(False, f"{label}: no summary.json")
+        return None
+    T.check(s["converged"] is True, f"{label}: converged = {s['converged']} ({s['failure']!r})")
+    T.conforms(out, scene)
+    return s
+
+
+def same_answers(label, ref, s):
+    """Forces, stresses and displacements as in the reference run, to TOL."""
+    a, b = summary_figures(ref), summary_figures(s)
+    for key in ("force", "stress", "displacement"):
+        worst, where, scale = worst_difference(a[key], b[key])
+        T.check(worst <= TOL, f"{label}: {key} worst {worst:.2e} of {scale:.4g} ({where}) (<= {TOL:g})")
+
+
 runs = {}
 # (label, GLIBC_TUNABLES, ranks, whether capstan asks for huge pages)
 for label, tunables, ranks, on in (("default", "", 1, True), ("off", "glibc.malloc.hugetlb=0", 1, False),
                                    ("other tunable kept", "glibc.malloc.tcache_count=7", 1, True),
                                    ("default, 2 ranks", "", 2, True)):
-    p, s, out = T.run_scene(scene, label.replace(" ", "-").replace(",", ""), sets=sets, ranks=ranks,
-                            env={"GLIBC_TUNABLES": tunables})
+    s = run(label, tunables, ranks)
     if s is None:
-        T.check(False, f"{label}: no summary.json")
         continue
-    T.check(s["converged"] is True, f"{label}: converged = {s['converged']} ({s['failure']!r})")
-    T.conforms(out, scene)
     huge = s["memory"].get("huge_pages_mib")
     if not T.check(isinstance(huge, list) and len(huge) == ranks, f"{label}: memory.huge_pages_mib per rank: {huge}"):
         continue
@@ -69,38 +86,23 @@ for label, tunables, ranks, on in (("default", "", 1, True), ("off", "glibc.mall
         T.check(all(h == 0 for h in huge), f"{label}: GLIBC_TUNABLES=glibc.malloc.hugetlb=0 turns them off: {huge}")
     runs[label] = s
 
-if "off" in runs:
-    ref = summary_figures(runs["off"])
-    for label, s in runs.items():
-        if label == "off" or s["ranks"] != 1:
-            continue
-        fig = summary_figures(s)
-        for key in ("force", "stress", "displacement"):
-            worst, where, scale = worst_difference(ref[key], fig[key])
-            T.check(worst <= TOL, f"{label} against off: {key} worst {worst:.2e} of {scale:.4g} ({where}) "
-                                  f"(<= {TOL:g})")
+for label, s in runs.items():
+    if "off" in runs and label != "off" and s["ranks"] == 1:
+        same_answers(f"{label} against off", runs["off"], s)
 
 # Page faults: capstan's settings against glibc's defaults set back by the user.
 glibc_defaults = "glibc.malloc.mmap_max=65536:glibc.malloc.trim_threshold=131072"
 faults = {}
-for label, tunables in (("capstan's heap", ""), ("glibc's defaults", glibc_defaults)):
-    p, s, out = T.run_scene(scene, "faults-" + label.split("'")[0].replace(" ", "-"),
-                            sets=sets + ["Mesh/Cells={42,12,18}", "Time/Steps=1"], env={"GLIBC_TUNABLES": tunables})
-    if s is None:
-        T.check(False, f"{label}: no summary.json")
-        continue
-    T.check(s["converged"] is True, f"{label}: converged = {s['converged']} ({s['failure']!r})")
-    T.conforms(out, scene)
-    f = s["memory"].get("page_faults")
-    if T.check(isinstance(f, list) and len(f) == 1 and f[0] > 0, f"{label}: memory.page_faults per rank: {f}"):
-        faults[label] = (f[0], s)
+for label, tunables in (("faults, capstan's heap", ""), ("faults, glibc's defaults", glibc_defaults)):
+    s = run(label, tunables, extra=["Mesh/Cells={42,12,18}", "Time/Steps=1"])
+    f = None if s is None else s["memory"].get("page_faults")
+    if s is not None and T.check(isinstance(f, list) and len(f) == 1 and f[0] > 0,
+                                 f"{label}: memory.page_faults per rank: {f}"):
+        faults[label] = s
         print(f"  {label}: {f[0]:.0f} page faults, peak {s['memory']['peak_rss_mib']} MiB")
 if len(faults) == 2:
-    mine, theirs = faults["capstan's heap"][0], faults["glibc's defaults"][0]
+    mine, theirs = (faults[k]["memory"]["page_faults"][0] for k in faults)
     T.check(mine <= 0.5 * theirs, f"capstan's heap takes at most half glibc's page faults: {mine:.0f} vs {theirs:.0f}")
-    ref, fig = summary_figures(faults["glibc's defaults"][1]), summary_figures(faults["capstan's heap"][1])
-    for key in ("force", "stress", "displacement"):
-        worst, where, scale = worst_difference(ref[key], fig[key])
-        T.check(worst <= TOL, f"page faults runs: {key} worst {worst:.2e} of {scale:.4g} ({where}) (<= {TOL:g})")
+    same_answers("faults runs", faults["faults, glibc's defaults"], faults["faults, capstan's heap"])
 
 T.finish()
