@@ -12,7 +12,6 @@ namespace capstan {
 
 struct MeshSpec {
   std::string type;  // Box | Annulus
-  std::string partition = "METIS";  // METIS | Slabs (over the MPI ranks)
   std::array<double, 3> min{}, max{};  // Box: its corners; Annulus: its bounding box
   std::array<int, 3> cells{};          // Box: x, y, z; Annulus: radial, circumferential, axial
   // Annulus: axis point at the zmin end (axis along +z), radii, length.
@@ -20,6 +19,8 @@ struct MeshSpec {
   double innerRadius = 0, outerRadius = 0, length = 0;
   double outerCellRatio = 1;             // radial grading (AnnulusGenerator)
   std::array<double, 3> fineSector{};    // {centre deg, width deg, fraction of cells}
+  std::string partition = "METIS";       // over the MPI ranks: METIS | Slabs (last: the
+                                         // tests and the bench fill the fields above in order)
   std::vector<std::string> faceNames() const;
 };
 
