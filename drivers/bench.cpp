@@ -119,7 +119,10 @@ int main(int argc, char** argv) {
 
   // ---- brick kernel on a deformed box
   Scene scene;
-  scene.mesh = {"Box", {0, 0, 0}, {1, 1, 1}, {n, n, n}};
+  scene.mesh.type = "Box";
+  scene.mesh.min = {0, 0, 0};
+  scene.mesh.max = {1, 1, 1};
+  scene.mesh.cells = {n, n, n};
   scene.solver = validParameters().sublist("Solver");
   scene.supports = {{"base", "ymin", "Fixed", {true, true, true}, 0, {0, 0, 0}}};
   BoxGenerator gen(scene.mesh.min, scene.mesh.max, scene.mesh.cells);

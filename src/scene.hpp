@@ -19,8 +19,7 @@ struct MeshSpec {
   double innerRadius = 0, outerRadius = 0, length = 0;
   double outerCellRatio = 1;             // radial grading (AnnulusGenerator)
   std::array<double, 3> fineSector{};    // {centre deg, width deg, fraction of cells}
-  std::string partition = "METIS";       // over the MPI ranks: METIS | Slabs (last: the
-                                         // tests and the bench fill the fields above in order)
+  std::string partition = "METIS";       // over the MPI ranks: METIS | Slabs
   std::vector<std::string> faceNames() const;
 };
 

@@ -20,7 +20,10 @@ namespace {
 
 Scene boxScene() {
   Scene s;
-  s.mesh = {"Box", {0, 0, 0}, {2, 1, 1.5}, {4, 2, 3}};
+  s.mesh.type = "Box";
+  s.mesh.min = {0, 0, 0};
+  s.mesh.max = {2, 1, 1.5};
+  s.mesh.cells = {4, 2, 3};
   s.c = 1.3;
   s.pressurePenalty = 1e-2;
   s.solver = validParameters().sublist("Solver");
