@@ -66,7 +66,7 @@ ParameterList validParameters() {
            "How the elements are split over MPI ranks: METIS (k-way on the dual graph, fewest faces "
            "cut) | Slabs (equal runs of the cells' numbering: slabs across z for a Box, along the "
            "axis for an Annulus; on G1 8x, 2 ranks take the Krylov iterations of 1 rank: "
-           "docs/performance.md, Partitions)");
+           "docs/performance.md, Page faults and partitions)");
   mesh.set("Fine Sector", vec3(0, 0, 0),
            "Annulus: {centre angle, width (degrees, from +x towards +y), fraction of the "
            "circumferential cells placed in it}: a finer sector where the nip is. Width 0: uniform");

@@ -917,13 +917,14 @@ void Run::writeSummary(bool converged, const std::string& failure) {
       if (key == "AnonHugePages:" && smaps >> kib) mine[1] = kib / 1024.0;
   }
   const int ranks = comm_->getSize();
-  std::vector<double> all(3 * ranks), peakMiB(ranks), hugeMiB(ranks), faults(ranks);
+  std::vector<double> all(3 * ranks);
   Teuchos::gatherAll(*comm_, 3, mine, 3 * ranks, all.data());
-  for (int r = 0; r < ranks; ++r) {
-    peakMiB[r] = all[3 * r];
-    hugeMiB[r] = all[3 * r + 1];
-    faults[r] = all[3 * r + 2];
-  }
+  auto perRank = [&](int figure) {
+    std::vector<double> v(ranks);
+    for (int r = 0; r < ranks; ++r) v[r] = all[3 * r + figure];
+    return v;
+  };
+  const auto peakMiB = perRank(0), hugeMiB = perRank(1), faults = perRank(2);
   if (!rank0_) return;
   using json::Object;
   auto vec = [](const std::array<double, 3>& v) { return json::array({v[0], v[1], v[2]}); };
