@@ -491,11 +491,11 @@ NewtonSolver::NewtonSolver(Assembly& assembly, const Teuchos::ParameterList& sol
 
 NewtonSolver::~NewtonSolver() = default;
 
-int NewtonSolver::linearSolve(const RCP<FEMatrix>& W, const Vector& b, Vector& x, double tolerance) {
+int NewtonSolver::linearSolve(const Vector& b, Vector& x, double tolerance) {
   Kokkos::Timer timer;
-  RCP<const Tpetra::Operator<>> op = W;
+  RCP<const Thyra::LinearOpBase<double>> W = impl_->W;
   auto space = impl_->model->get_x_space();
-  auto lows = Thyra::linearOpWithSolve(*impl_->lows, Thyra::createConstLinearOp(op));
+  auto lows = Thyra::linearOpWithSolve(*impl_->lows, W);
   auto bt = Thyra::createConstVector(Teuchos::rcpFromRef(b), space);
   auto xt = Thyra::createVector(Teuchos::rcpFromRef(x), space);
   int iterations = -1;

@@ -31,10 +31,12 @@ class NewtonSolver {
   // Solves R(u) = 0 from the initial guess u (updated in place) until
   // |R| <= tolerance.
   NewtonResult solve(Vector& u, double tolerance);
-  // One linear solve W x = b with the configured solver (x: initial guess in,
-  // solution out) to the relative residual `tolerance` (Krylov solvers).
+  // One linear solve W x = b with Newton's matrix W = matrix(), as the caller
+  // assembled it, and the configured solver with a preconditioner of its own
+  // (x: initial guess in, solution out), to the relative residual `tolerance`
+  // (Krylov solvers). Newton reassembles W before it next solves.
   // Returns the Krylov iterations, or -1 if it failed.
-  int linearSolve(const RCP<FEMatrix>& W, const Vector& b, Vector& x, double tolerance);
+  int linearSolve(const Vector& b, Vector& x, double tolerance);
   // Newton's next linear solve builds a new preconditioner (with Solver/
   // Preconditioner Reuse = Adaptive it is otherwise kept while it works).
   void rebuildPreconditioner();

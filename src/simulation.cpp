@@ -267,7 +267,6 @@ class Run {
   std::unique_ptr<NewtonSolver> newton_;
   std::unique_ptr<PressureStep> pressureStep_;  // null with Solver/Pressure Update = Anderson
   std::vector<Kokkos::View<double*>> pressureStepDmu_;  // per effect: its multipliers' change in the step
-  RCP<FEMatrix> predictorMatrix_;
   RCP<Vector> u_;
   std::unique_ptr<FieldWriter> writer_;
   std::vector<StepRecord> steps_;
@@ -296,8 +295,9 @@ void Run::predict(double t0, double t1, double bareResidual, StepRecord& rec) {
   const auto map = u_->getMap();
   Vector z(map), Kz(map), f(map), rhs(map), du(map);
   assembly_->constraintIncrement(z, t0, t1);
-  if (predictorMatrix_.is_null()) predictorMatrix_ = assembly_->createMatrix();  // one for the run
-  const RCP<FEMatrix>& W = predictorMatrix_;
+  // Newton's matrix (Newton reassembles it before it solves): a G1 8x matrix
+  // is about 0.5 GB, too much to keep one for the predictor alone.
+  const RCP<FEMatrix> W = newton_->matrix();
   // Effects linearise for the predictor: the bare state penetrates the
   // capstans by the whole increment (contact leaves out its geometric
   // stiffness, t_n / d, large there) and slides over them by the capstan's
@@ -319,7 +319,7 @@ void Run::predict(double t0, double t1, double bareResidual, StepRecord& rec) {
   // A first guess: 1e-6 is plenty (Newton corrects it), and a tighter
   // tolerance on a nearly steady step, where the right-hand side is at
   // round-off, ran GMRES to its limit (H1 8x: 92 s per steady step).
-  const int its = newton_->linearSolve(W, rhs, du, std::max(1e-6, scene_.solver.get<double>("Linear Tolerance")));
+  const int its = newton_->linearSolve(rhs, du, std::max(1e-6, scene_.solver.get<double>("Linear Tolerance")));
   for (const auto& e : assembly_->effects()) e->setPredicting(false);
   if (its < 0) return;  // keep the plain guess
   rec.linear += its;
