@@ -26,15 +26,13 @@ pressure steps (split out in their own columns).
 """
 import argparse
 import csv
-import json
 import os
-import subprocess
-import sys
+
+from capstan_runs import CAPSTAN, CASES, command, summary, totals
 
 ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-root = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
 ap.add_argument("--out", default="out/scaling")
-ap.add_argument("--capstan", default=os.path.join(root, "build", "capstan"))
+ap.add_argument("--capstan", default=CAPSTAN)
 ap.add_argument("--g1", default="1,2,4", help="G1 refinement factors ('' for none)")
 ap.add_argument("--h1", default="2,4,8", help="H1 refinement factors ('' for none)")
 ap.add_argument("--ranks", default="1,2")
@@ -43,9 +41,6 @@ ap.add_argument("--set", action="append", default=[], metavar="PATH=VALUE",
                 help="an extra scene parameter for every run (capstan run --set), e.g. "
                      "'Solver/Pressure Step Schur=Diagonal'; repeatable")
 args = ap.parse_args()
-
-CASES = {"G1": ("inputs/seed/g1.xml", (14, 4, 6)), "H1": ("inputs/seed/h1.xml", (20, 2, 1))}
-env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
 
 
 def factors(text):
@@ -60,31 +55,9 @@ for case, f in plan:
     for ranks in factors(args.ranks):
         tag = f"{case.lower()}-{f}x-{ranks}r" + (f"-{args.steps}steps" if args.steps else "")
         out = os.path.join(args.out, tag)
-        summary = os.path.join(out, "summary.json")
-        if not os.path.isfile(summary):
-            cmd = [args.capstan, "run", os.path.join(root, scene), "--output", out, "--quiet",
-                   "--set", "Mesh/Cells={%d,%d,%d}" % tuple(cells),
-                   "--set", "Solver/Linear Solver=GMRES", "--set", "Solver/Preconditioner=MueLu",
-                   "--set", "Output/Write Fields=false"]
-            for extra in args.set:
-                cmd += ["--set", extra]
-            if args.steps:
-                cmd += ["--set", f"Time/Steps={args.steps}"]
-            if ranks > 1:
-                cmd = ["mpiexec", "--oversubscribe", "-n", str(ranks)] + cmd
-            print(f"  {tag} ...", flush=True)
-            run = subprocess.run(cmd, env=env, capture_output=True, text=True)
-            if not os.path.isfile(summary):
-                sys.exit(f"scaling.py: {tag} wrote no summary.json (exit {run.returncode}):\n{run.stderr}")
-        with open(summary) as fh:
-            s = json.load(fh)
+        s = summary(out, command(args.capstan, scene, out, cells, ranks, args.set, args.steps), tag, "scaling.py")
         steps = s["steps"]
-        newton = sum(st["newton_iterations"] for st in steps)
-        linear = sum(st["linear_iterations"] for st in steps)
-        # Krylov iterations of the saddle-point pressure steps (part of linear;
-        # absent from summaries written before the key existed).
-        pstep = (sum(st["pressure_step_iterations"] for st in steps)
-                 if all("pressure_step_iterations" in st for st in steps) else None)
+        newton, linear, pstep = totals(s)
         log = os.path.join(out, "run.log")  # a run made by hand with CAPSTAN_NEWTON_LOG=1
         if pstep is None and os.path.isfile(log):
             with open(log) as fh:

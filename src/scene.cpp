@@ -222,6 +222,16 @@ struct Validator {
     throw InputError(file + ": " + (path.empty() ? "" : "parameter '" + path + "': ") + what);
   }
 
+  // A string parameter `path`/`name` of `list` that must be one of `allowed`.
+  void oneOf(const ParameterList& list, const std::string& path, const std::string& name,
+             const std::set<std::string>& allowed) const {
+    const auto& val = list.get<std::string>(name);
+    if (allowed.count(val)) return;
+    std::string names;
+    for (const auto& a : allowed) names += (names.empty() ? "" : ", ") + a;
+    fail(path + "/" + name, "'" + val + "' is not one of " + names);
+  }
+
   // Unknown names and wrong types; fills in defaults. An int given where a
   // double is expected is accepted and converted.
   void check(ParameterList& user, const ParameterList& valid, const std::string& path) const {
@@ -822,8 +832,7 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
   const auto& mesh = P.sublist("Mesh");
   sc.mesh.type = mesh.get<std::string>("Type");
   sc.mesh.partition = mesh.get<std::string>("Partition");
-  if (sc.mesh.partition != "METIS" && sc.mesh.partition != "Slabs")
-    v.fail("Mesh/Partition", "'" + sc.mesh.partition + "' is not one of METIS, Slabs");
+  v.oneOf(mesh, "Mesh", "Partition", {"METIS", "Slabs"});
   sc.mesh.cells = three<int>(mesh, "Cells", v, "Mesh");
   for (int d = 0; d < 3; ++d)
     if (sc.mesh.cells[d] < 1) v.fail("Mesh/Cells", "each count must be >= 1");
@@ -973,13 +982,8 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
 
   sc.solver = P.sublist("Solver");
   const auto& sol = sc.solver;
-  auto oneOf = [&](const std::string& name, std::set<std::string> allowed) {
-    const auto& val = sol.get<std::string>(name);
-    if (!allowed.count(val)) {
-      std::string list;
-      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-      v.fail("Solver/" + name, "'" + val + "' is not one of " + list);
-    }
+  auto oneOf = [&](const std::string& name, const std::set<std::string>& allowed) {
+    v.oneOf(sol, "Solver", name, allowed);
   };
   oneOf("Linear Solver", {"Auto", "GMRES", "CG", "Direct"});
   for (const auto& c : sc.capstans)

@@ -1,0 +1,54 @@
+"""Running capstan from the study scripts (scaling.py, speedup.py): the command
+line of one run, the run itself, and the totals of its summary.json."""
+import json
+import os
+import subprocess
+import sys
+
+ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+CAPSTAN = os.path.join(ROOT, "build", "capstan")
+# The scaling cases: scene and the cells of the 1x mesh (refined by a factor
+# in every direction).
+CASES = {"G1": ("inputs/seed/g1.xml", (14, 4, 6)), "H1": ("inputs/seed/h1.xml", (20, 2, 1))}
+ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+
+
+def command(capstan, scene, out, cells, ranks, sets=(), steps=0):
+    """`capstan run` of `scene` with GMRES + MueLu and no field output, so that
+    every size and rank count runs the same method; `sets` are extra --set
+    PATH=VALUE strings."""
+    cmd = [capstan, "run", os.path.join(ROOT, scene), "--output", out, "--quiet",
+           "--set", "Mesh/Cells={%d,%d,%d}" % tuple(cells),
+           "--set", "Solver/Linear Solver=GMRES", "--set", "Solver/Preconditioner=MueLu",
+           "--set", "Output/Write Fields=false"]
+    for extra in sets:
+        cmd += ["--set", extra]
+    if steps:
+        cmd += ["--set", f"Time/Steps={steps}"]
+    if ranks > 1:
+        cmd = ["mpiexec", "--oversubscribe", "-n", str(ranks)] + cmd
+    return cmd
+
+
+def summary(out, cmd, tag, script):
+    """OUT/summary.json, after running `cmd` if it is not there yet (a run made
+    earlier, or by hand, is reused; delete OUT to redo it)."""
+    path = os.path.join(out, "summary.json")
+    if not os.path.isfile(path):
+        print(f"  {tag} ...", flush=True)
+        run = subprocess.run(cmd, env=ENV, capture_output=True, text=True)
+        if not os.path.isfile(path):
+            sys.exit(f"{script}: {tag} wrote no summary.json (exit {run.returncode}):\n{run.stderr}")
+    with open(path) as fh:
+        return json.load(fh)
+
+
+def totals(s):
+    """Newton iterations, Krylov iterations (all), and those of the pressure
+    steps (None in summaries written before the key existed)."""
+    steps = s["steps"]
+    newton = sum(st["newton_iterations"] for st in steps)
+    linear = sum(st["linear_iterations"] for st in steps)
+    pstep = (sum(st["pressure_step_iterations"] for st in steps)
+             if all("pressure_step_iterations" in st for st in steps) else None)
+    return newton, linear, pstep

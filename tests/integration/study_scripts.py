@@ -1,0 +1,105 @@
+#!/usr/bin/env python3
+"""The performance study scripts run and report what the runs' summaries say.
+
+scripts/scaling.py on G1 1x (1 and 2 ranks) and scripts/speedup.py on G1 1x for
+one load step, two rounds (1 rank, 2 ranks with METIS, 2 ranks with Slabs):
+
+  * every run's summary.json conforms to interface.md (check_summary.py --scene);
+  * scaling.csv holds the runs' DOFs, Newton and Krylov iterations and total times
+    as their summaries give them;
+  * speedup.csv has one row per run, each round's 2-rank runs carry their
+    partition, and speedup.md states each round's speed-up (1 rank's time over 2
+    ranks') and their mean, to the printed 2 decimals;
+  * a second call with the same --out reuses the runs (no summary.json rewritten)
+    and may add rounds;
+  * the PNGs are written.
+"""
+import csv
+import os
+import re
+import statistics
+import subprocess
+import sys
+
+sys.dont_write_bytecode = True
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from capstan_test import Test  # noqa: E402
+
+T = Test("study_scripts", __doc__)
+scripts = os.path.normpath(os.path.join(T.inputs, "..", "scripts"))
+g1 = T.input("seed/g1.xml")
+
+
+def script(name, *args):
+    cmd = [sys.executable, os.path.join(scripts, name), "--capstan", T.capstan] + list(args)
+    print("  $ " + " ".join(cmd))
+    p = subprocess.run(cmd, capture_output=True, text=True, timeout=600,
+                       env=dict(os.environ, OMPI_MCA_rmaps_base_oversubscribe="1"))
+    T.check(p.returncode == 0, f"{name}: exit status {p.returncode}" +
+            ("" if p.returncode == 0 else ": " + (p.stdout[-1500:] + p.stderr[-1500:]).replace("\n", " | ")))
+    return p
+
+
+def summaries(out):
+    import json
+    runs = {}
+    for d in sorted(os.listdir(out)):
+        path = os.path.join(out, d, "summary.json")
+        if os.path.isfile(path):
+            with open(path) as fh:
+                runs[d] = json.load(fh)
+            T.conforms(os.path.join(out, d), g1)
+    return runs
+
+
+# --- scaling.py --------------------------------------------------------------
+out = T.path("scaling")
+script("scaling.py", "--out", out, "--g1", "1", "--h1", "")
+runs = summaries(out)
+T.check(sorted(runs) == ["g1-1x-1r", "g1-1x-2r"], f"scaling.py ran {sorted(runs)}")
+with open(os.path.join(out, "scaling.csv")) as fh:
+    rows = list(csv.DictReader(fh))
+for r in rows:
+    s = runs.get(f"g1-1x-{r['ranks']}r")
+    if s is None:
+        continue
+    want = (s["mesh"]["dofs"], sum(st["newton_iterations"] for st in s["steps"]),
+            sum(st["linear_iterations"] for st in s["steps"]), round(s["timing"]["total"], 2))
+    got = (int(r["dofs"]), int(r["newton"]), int(r["linear"]), float(r["total_s"]))
+    T.check(got == want, f"scaling.csv, {r['ranks']} rank(s): dofs, Newton, Krylov, total s {got} (summary: {want})")
+T.check(os.path.getsize(os.path.join(out, "scaling.png")) > 10000, "scaling.png written")
+
+# --- speedup.py --------------------------------------------------------------
+out = T.path("speedup")
+args = ["--out", out, "--factor", "1", "--steps", "1"]
+script("speedup.py", *args, "--rounds", "1")
+first = {d: os.path.getmtime(os.path.join(out, d, "summary.json")) for d in ("a-1r", "a-metis", "a-slabs")
+         if os.path.isfile(os.path.join(out, d, "summary.json"))}
+p = script("speedup.py", *args, "--rounds", "2")
+runs = summaries(out)
+names = ["a-1r", "a-metis", "a-slabs", "b-1r", "b-metis", "b-slabs"]
+T.check(sorted(runs) == names, f"speedup.py, 2 rounds: runs {sorted(runs)}")
+again = {d: os.path.getmtime(os.path.join(out, d, "summary.json")) for d in first}
+T.check(len(first) == 3 and first == again, f"round a's {len(first)} runs reused by the second call, not rerun")
+for d, s in runs.items():
+    want = {"1r": (1, None), "metis": (2, "METIS"), "slabs": (2, "Slabs")}[d[2:]]
+    got = (s["ranks"], s["mesh"]["partition"] if s["ranks"] > 1 else None)
+    T.check(got == want and len(s["steps"]) == 1, f"{d}: ranks, partition {got}, {len(s['steps'])} step")
+with open(os.path.join(out, "speedup.csv")) as fh:
+    rows = list(csv.DictReader(fh))
+T.check(len(rows) == 6, f"speedup.csv: {len(rows)} rows (6)")
+with open(os.path.join(out, "speedup.md")) as fh:
+    md = fh.read()
+if len(runs) == 6:
+    for part in ("metis", "slabs"):
+        ratios = [runs[f"{k}-1r"]["timing"]["total"] / runs[f"{k}-{part}"]["timing"]["total"] for k in "ab"]
+        line = next((ln for ln in md.splitlines() if ln.startswith(f"- {part}:")), "")
+        m = re.search(r"speed-ups ([\d.]+)x, ([\d.]+)x; mean ([\d.]+)x", line)
+        stated = [float(x) for x in m.groups()] if m else []
+        want = ratios + [statistics.mean(ratios)]
+        T.check(len(stated) == 3 and all(abs(a - b) <= 0.006 for a, b in zip(stated, want)),
+                f"speedup.md, {part}: speed-ups and mean {stated} (from the summaries: "
+                f"{[round(x, 3) for x in want]})")
+T.check(os.path.getsize(os.path.join(out, "speedup.png")) > 10000, "speedup.png written")
+
+T.finish()
