@@ -52,3 +52,19 @@ def totals(s):
     pstep = (sum(st["pressure_step_iterations"] for st in steps)
              if all("pressure_step_iterations" in st for st in steps) else None)
     return newton, linear, pstep
+
+
+def write_report(path, lines):
+    """Writes the markdown lines to `path` and prints them."""
+    text = "\n".join(lines) + "\n"
+    with open(path, "w") as fh:
+        fh.write(text)
+    print(text)
+
+
+def pyplot():
+    """matplotlib's pyplot, drawing to files only (no display needed)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt

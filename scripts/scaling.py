@@ -28,7 +28,7 @@ import argparse
 import csv
 import os
 
-from capstan_runs import CAPSTAN, CASES, command, summary, totals
+from capstan_runs import CAPSTAN, CASES, command, pyplot, summary, totals, write_report
 
 ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
 ap.add_argument("--out", default="out/scaling")
@@ -107,14 +107,8 @@ for r in rows:
                          f"({r['total_s']} s vs {q['total_s']} s; Newton {r['newton']} vs {q['newton']}, "
                          f"linear/Newton {r['linear_per_newton']} vs {q['linear_per_newton']}; "
                          f"per Krylov iteration {per_it:.2f}x, Krylov iterations {q['linear'] / max(r['linear'], 1):.2f}x)")
-text = "\n".join(lines) + "\n"
-with open(os.path.join(args.out, "scaling.md"), "w") as fh:
-    fh.write(text)
-print(text)
-
-import matplotlib
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
+write_report(os.path.join(args.out, "scaling.md"), lines)
+plt = pyplot()
 
 fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
 for ax, key, label in [(axes[0], "per_newton_s", "wall time per Newton iteration (s)"),

@@ -30,7 +30,7 @@ import datetime
 import os
 import statistics
 
-from capstan_runs import CAPSTAN, CASES, command, summary, totals
+from capstan_runs import CAPSTAN, CASES, command, pyplot, summary, totals, write_report
 
 ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
 ap.add_argument("--out", default="out/speedup")
@@ -103,14 +103,8 @@ for v in variants[1:]:
                  f"Of the mean times ({mean['1r']:.1f} s against {mean[v]:.1f} s): {mean['1r'] / mean[v]:.2f}x, "
                  f"per Krylov iteration {per_it:.2f}x, Krylov iterations {its[v] / its['1r']:.3f}x "
                  f"({its[v]:.0f} against {its['1r']:.0f})")
-text = "\n".join(lines) + "\n"
-with open(os.path.join(args.out, "speedup.md"), "w") as fh:
-    fh.write(text)
-print(text)
-
-import matplotlib
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
+write_report(os.path.join(args.out, "speedup.md"), lines)
+plt = pyplot()
 
 fig, ax = plt.subplots(figsize=(7, 4))
 for v, marker in zip(variants[1:], "os^v"):
