@@ -246,9 +246,14 @@ RCP<const Map> dofMap(const std::vector<GO>& nodes, const RCP<const Comm>& comm)
 
 }  // namespace
 
+Partition autoPartition(int slowestCells, int ranks) {
+  return ranks > 1 && slowestCells / ranks >= kAutoSlabLayers ? Partition::Slabs : Partition::Metis;
+}
+
 Mesh distributeMesh(const MeshGenerator& gen, const RCP<const Comm>& comm, Partition partition) {
   Mesh m;
   m.comm = comm;
+  m.partition = partition;
   m.numGlobalNodes = gen.numNodes();
   m.numGlobalElements = gen.numElements();
   m.faceNames = gen.faceNames();

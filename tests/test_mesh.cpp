@@ -180,9 +180,29 @@ TEST(Partition, MetisCutsFewFacesAndCountsThem) {
   const Mesh mesh = distributeMesh(gen, Tpetra::getDefaultComm(), Partition::Metis);
   const int ranks = mesh.comm->getSize();
   EXPECT_EQ(mesh.numCutFaces, countCutFaces(gen, mesh));
-  if (ranks == 1) EXPECT_EQ(mesh.numCutFaces, 0);
+  if (ranks == 1) {
+    EXPECT_EQ(mesh.numCutFaces, 0);
+  }
   // Two ranks: no worse than the best plane (across x: 4 x 8 faces) by much.
-  if (ranks == 2) EXPECT_LE(mesh.numCutFaces, 2 * 4 * 8);
+  if (ranks == 2) {
+    EXPECT_LE(mesh.numCutFaces, 2 * 4 * 8);
+  }
+}
+
+// Auto picks slabs only where each rank's slab is kAutoSlabLayers (16) cells
+// thick or more, and only on several ranks; the mesh records what it used.
+TEST(Partition, AutoPicksThickSlabsOnly) {
+  EXPECT_EQ(autoPartition(48, 2), Partition::Slabs);  // G1 8x: 24 layers a rank
+  EXPECT_EQ(autoPartition(32, 2), Partition::Slabs);
+  EXPECT_EQ(autoPartition(31, 2), Partition::Metis);
+  EXPECT_EQ(autoPartition(24, 2), Partition::Metis);  // G1 4x: 12
+  EXPECT_EQ(autoPartition(8, 2), Partition::Metis);   // H1 8x: 4
+  EXPECT_EQ(autoPartition(48, 1), Partition::Metis);  // one rank: nothing to split
+  EXPECT_EQ(autoPartition(64, 4), Partition::Slabs);
+  EXPECT_EQ(autoPartition(60, 4), Partition::Metis);
+  BoxGenerator gen({0, 0, 0}, {1, 1, 1}, {2, 2, 2});
+  EXPECT_EQ(distributeMesh(gen, Tpetra::getDefaultComm(), Partition::Slabs).partition, Partition::Slabs);
+  EXPECT_EQ(distributeMesh(gen, Tpetra::getDefaultComm(), Partition::Metis).partition, Partition::Metis);
 }
 
 TEST(Partition, BoxSlabsAreRunsAcrossZ) {

@@ -10,11 +10,13 @@ augmented Lagrangian), H1 (tanh friction) and H5 (Coulomb friction) on 1 and 2 r
     relative to the largest magnitude of their kind;
   * fields.h5: the final displacement of every node, matched by its reference
     coordinates (node order depends on the partition), agrees to 1e-8 x max |u|.
-METIS splits the 2-rank runs by default (summary.json mesh.partition; mesh.cut_faces is 0 on
-1 rank, above 0 on 2). Then G1 with Solver/Linear Solver = Direct on 2 ranks: capstan notes
+METIS splits the 2-rank runs of these thin meshes by default (Mesh/Partition = Auto;
+summary.json mesh.partition; mesh.cut_faces is 0 on 1 rank, above 0 on 2). Then G1 with Solver/Linear Solver = Direct on 2 ranks: capstan notes
 that it uses GMRES instead (KLU2 through Amesos2 fails on several ranks) and matches the
 1-rank forces. And G1 with Mesh/Partition = Slabs on 2 ranks: 56 faces cut (one plane of
-14 x 4), every summary figure as on 1 rank.
+14 x 4), every summary figure as on 1 rank. Auto on 2 ranks, one step: G1 with 32 layers
+(16 a rank) is split into slabs (56 faces cut), with 30 layers (15 a rank) by METIS (which
+here finds a plane too).
 """
 import os
 import sys
@@ -105,5 +107,17 @@ if s is not None and "seed/g1.xml" in serial:
         T.check(worst <= TOL, f"G1, slabs on 2 ranks: {group} agrees with 1 rank: worst {worst:.2e} ({k}) (<= {TOL:g})")
 else:
     T.check(False, "G1, slabs on 2 ranks: no summary.json (or no 1-rank run to compare with)")
+
+# Mesh/Partition = Auto: slabs once each rank's slab is 16 cell layers thick.
+for layers, want in ((32, "Slabs"), (30, "METIS")):
+    p, s, out = T.run_scene(g1, f"g1-auto-{layers}", ranks=2,
+                            sets=[f"Mesh/Cells={{14,4,{layers}}}", "Time/Steps=1", "Output/Write Fields=false"])
+    if s is None:
+        T.check(False, f"G1 with {layers} layers, Auto on 2 ranks: no summary.json")
+        continue
+    cut = s["mesh"]["cut_faces"]
+    T.check(s["converged"] is True and s["mesh"]["partition"] == want and (cut == 14 * 4 or want == "METIS"),
+            f"G1 with {layers} layers, Auto on 2 ranks: mesh.partition {s['mesh']['partition']!r} ({want}), "
+            f"cut_faces {cut}, converged {s['converged']}")
 
 T.finish()
