@@ -250,6 +250,14 @@ Partition autoPartition(int slowestCells, int ranks) {
   return ranks > 1 && slowestCells / ranks >= kAutoSlabLayers ? Partition::Slabs : Partition::Metis;
 }
 
+Partition partitionFor(const std::string& name, int slowestCells, int ranks) {
+  if (name == "Slabs") return Partition::Slabs;
+  if (name == "METIS") return Partition::Metis;
+  return autoPartition(slowestCells, ranks);
+}
+
+const char* partitionName(Partition partition) { return partition == Partition::Slabs ? "Slabs" : "METIS"; }
+
 Mesh distributeMesh(const MeshGenerator& gen, const RCP<const Comm>& comm, Partition partition) {
   Mesh m;
   m.comm = comm;

@@ -1008,7 +1008,7 @@ void Run::writeSummary(bool converged, const std::string& failure) {
       .add("elements", json::number(long(mesh_.numGlobalElements)))
       .add("dofs", json::number(long(3 * mesh_.numGlobalNodes)))
       .add("contact_faces", json::number(numContactFaces_))
-      .add("partition", json::string(mesh_.partition == Partition::Slabs ? "Slabs" : "METIS"))
+      .add("partition", json::string(partitionName(mesh_.partition)))
       .add("cut_faces", json::number(long(mesh_.numCutFaces)));
   Object top;
   top.add("title", json::string(scene_.title)).add("scene", json::string(scene_.file))
@@ -1343,10 +1343,7 @@ int Run::execute() {
                                                     m.outerCellRatio, m.fineSector);
   else
     generator_ = std::make_unique<BoxGenerator>(m.min, m.max, m.cells);
-  const Partition partition = m.partition == "Slabs"   ? Partition::Slabs
-                              : m.partition == "METIS" ? Partition::Metis
-                                                       : autoPartition(m.cells[2], comm_->getSize());
-  mesh_ = distributeMesh(*generator_, comm_, partition);
+  mesh_ = distributeMesh(*generator_, comm_, partitionFor(m.partition, m.cells[2], comm_->getSize()));
   assembly_ = std::make_unique<Assembly>(mesh_, scene_);
   try {
     newton_ = std::make_unique<NewtonSolver>(*assembly_, scene_.solver);

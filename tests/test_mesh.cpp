@@ -200,6 +200,12 @@ TEST(Partition, AutoPicksThickSlabsOnly) {
   EXPECT_EQ(autoPartition(48, 1), Partition::Metis);  // one rank: nothing to split
   EXPECT_EQ(autoPartition(64, 4), Partition::Slabs);
   EXPECT_EQ(autoPartition(60, 4), Partition::Metis);
+  EXPECT_EQ(partitionFor("Auto", 48, 2), Partition::Slabs);
+  EXPECT_EQ(partitionFor("Auto", 24, 2), Partition::Metis);
+  EXPECT_EQ(partitionFor("METIS", 48, 2), Partition::Metis);
+  EXPECT_EQ(partitionFor("Slabs", 8, 2), Partition::Slabs);
+  EXPECT_STREQ(partitionName(Partition::Slabs), "Slabs");
+  EXPECT_STREQ(partitionName(Partition::Metis), "METIS");
   BoxGenerator gen({0, 0, 0}, {1, 1, 1}, {2, 2, 2});
   EXPECT_EQ(distributeMesh(gen, Tpetra::getDefaultComm(), Partition::Slabs).partition, Partition::Slabs);
   EXPECT_EQ(distributeMesh(gen, Tpetra::getDefaultComm(), Partition::Metis).partition, Partition::Metis);

@@ -15,6 +15,7 @@ one load step, two rounds (1 rank, 2 ranks with METIS, 2 ranks with Slabs):
   * the PNGs are written.
 """
 import csv
+import json
 import os
 import re
 import statistics
@@ -41,7 +42,6 @@ def script(name, *args):
 
 
 def summaries(out):
-    import json
     runs = {}
     for d in sorted(os.listdir(out)):
         path = os.path.join(out, d, "summary.json")
