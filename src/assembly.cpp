@@ -150,7 +150,7 @@ Assembly::Assembly(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
     Kokkos::deep_copy(h, size_t(81 + 4 * cores_.size()));
     std::vector<std::vector<char>> seen(cores_.size(), std::vector<char>(constraints_.supportOf.size(), 0));
     for (const auto& effect : effects_) {
-      if (effect->local().K.extent(0) == 0) continue;
+      if (!effect->local().stiff) continue;
       auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), effect->local().dofs);
       for (size_t e = 0; e < dofs.extent(0); ++e)
         for (size_t k = 0; k < dofs.extent(1); ++k) {
@@ -170,7 +170,7 @@ Assembly::Assembly(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
   graph_->beginAssembly();
   for (const auto& effect : effects_) {
     coupled_.emplace_back();
-    if (effect->local().K.extent(0) == 0) continue;  // no stiffness, no graph entries
+    if (!effect->local().stiff) continue;  // no stiffness, no graph entries
     auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), effect->local().dofs);
     std::vector<GO> cols;
     for (size_t e = 0; e < dofs.extent(0); ++e) {
@@ -199,7 +199,7 @@ Assembly::Assembly(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
   columnOf_.resize(constraints_.supportOf.size());
   for (size_t d = 0; d < columnOf_.size(); ++d) columnOf_[d] = colMap.getLocalElement(gid(int(d)));
   for (const auto& effect : effects_) {
-    if (effect->local().K.extent(0) == 0) {
+    if (!effect->local().stiff) {
       columns_.emplace_back();
       continue;
     }
@@ -209,7 +209,7 @@ Assembly::Assembly(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
       for (size_t k = 0; k < dofs.extent(1); ++k) cols[e * dofs.extent(1) + k] = columnOf_[dofs(e, k)];
     columns_.push_back(std::move(cols));
   }
-  findEntryOffsets();
+  buildTangentSinks();
   uOverlap_ = rcp(new Vector(overlapDofMap_));
   residual_ = rcp(new Tpetra::FEMultiVector<>(ownedDofMap_, importer_, 1));
   x_ = NodalVectors("x", mesh.numOverlapNodes());
@@ -235,14 +235,15 @@ void Assembly::assembleCoreCoupling(FEMatrix& W) {
   touched.assign(nodeDofs_, 0);
   for (size_t i = 0; i < effects_.size(); ++i) {
     const auto& L = effects_[i]->local();
-    if (L.K.extent(0) == 0 || coupled_[i].empty()) continue;
+    if (!L.stiff || coupled_[i].empty()) continue;
     const auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.dofs);
-    const auto K = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.K);
+    const auto K = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sinks_[i].kept);
     const auto active = activeOnHost(L);
     const int n = int(dofs.extent(1));
     std::vector<std::array<double, 4>> B(n);
     std::vector<int> coreOf(n);
-    for (int e : coupled_[i]) {
+    for (size_t slot = 0; slot < coupled_[i].size(); ++slot) {
+      const int e = coupled_[i][slot];
       if (active.size() && !active(e)) continue;
       for (int k = 0; k < n; ++k) {
         const int d = dofs(e, k), c = coreOfNode_[d / 3];
@@ -252,7 +253,7 @@ void Assembly::assembleCoreCoupling(FEMatrix& W) {
       for (int k = 0; k < n; ++k)
         for (int l = 0; l < n; ++l) {
           const int ck = coreOf[k], cl = coreOf[l], dk = dofs(e, k), dl = dofs(e, l);
-          const double Kkl = K(e, k, l);
+          const double Kkl = K(slot, k, l);
           if ((ck < 0 && cl < 0) || Kkl == 0) continue;
           if (ck < 0) {
             if (supportOf[dk] >= 0) continue;
@@ -301,7 +302,7 @@ void Assembly::assembleCoreCoupling(FEMatrix& W) {
   }
 }
 
-void Assembly::findEntryOffsets() {
+void Assembly::buildTangentSinks() {
   // The owned-plus-shared matrix is active between beginAssembly and endAssembly;
   // its local rows are the overlapped dof ids the effects use.
   auto W = createMatrix();
@@ -319,22 +320,47 @@ void Assembly::findEntryOffsets() {
   const auto& supportOf = constraints_.supportOf;
   for (size_t i = 0; i < effects_.size(); ++i) {
     const auto& L = effects_[i]->local();
-    if (L.K.extent(0) == 0) {
-      entryOffsets_.emplace_back();
-      continue;
-    }
+    sinks_.emplace_back();
+    if (!L.stiff) continue;
+    TangentSink& sink = sinks_.back();
     auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.dofs);
-    const size_t n = dofs.extent(1);
-    Kokkos::View<int***, Kokkos::LayoutRight> offsets("entry offsets", dofs.extent(0), n, n);
-    auto h = Kokkos::create_mirror_view(offsets);
-    for (size_t e = 0; e < dofs.extent(0); ++e)
+    const size_t ne = dofs.extent(0), n = dofs.extent(1), nb = n / 3;
+    sink.rowBlock = decltype(sink.rowBlock)("tangent row blocks", ne, n * nb);
+    sink.heldColumns = Kokkos::View<int*>("tangent held columns", ne);
+    auto hb = Kokkos::create_mirror_view(sink.rowBlock);
+    auto hh = Kokkos::create_mirror_view(sink.heldColumns);
+    for (size_t e = 0; e < ne; ++e) {
+      int held = 0;
+      for (size_t l = 0; l < n; ++l)
+        if (supportOf[dofs(e, l)] >= 0) held |= 1 << l;
+      hh(e) = held;
       for (size_t k = 0; k < n; ++k)
-        for (size_t l = 0; l < n; ++l)
-          h(e, k, l) = supportOf[dofs(e, k)] >= 0 || supportOf[dofs(e, l)] >= 0
-                           ? -1
-                           : find(overlapLid(dofs(e, k)), columns_[i][e * n + l]);
-    Kokkos::deep_copy(offsets, h);
-    entryOffsets_.push_back(offsets);
+        for (size_t b = 0; b < nb; ++b) {
+          int& o = hb(e, k * nb + b);
+          o = -1;
+          if (supportOf[dofs(e, k)] >= 0) continue;  // a held row: the identity
+          // A node's 3 columns sit side by side in every row (its dofs have
+          // consecutive column ids, and each row's entries are sorted).
+          for (size_t j = 0; j < 3; ++j) {
+            if (held & (1 << (3 * b + j))) continue;
+            const int at = find(overlapLid(dofs(e, k)), columns_[i][e * n + 3 * b + j]) - int(j);
+            if (o >= 0 && at != o)
+              throw std::logic_error("assembly: a node's 3 columns are not side by side in a matrix row");
+            o = at;
+          }
+          if (o < 0) o = 0;  // all 3 columns held: the bits skip them
+        }
+    }
+    Kokkos::deep_copy(sink.rowBlock, hb);
+    Kokkos::deep_copy(sink.heldColumns, hh);
+    if (!coupled_[i].empty()) {
+      sink.keepSlot = Kokkos::View<int*>("tangent keep slot", ne);
+      sink.kept = decltype(sink.kept)("kept tangents", coupled_[i].size(), n, n);
+      auto hk = Kokkos::create_mirror_view(sink.keepSlot);
+      Kokkos::deep_copy(hk, -1);
+      for (size_t slot = 0; slot < coupled_[i].size(); ++slot) hk(coupled_[i][slot]) = int(slot);
+      Kokkos::deep_copy(sink.keepSlot, hk);
+    }
   }
   std::vector<int> diagonal;
   for (LO d = 0; d < LO(ownedDofMap_->getNodeNumElements()); ++d)
@@ -478,7 +504,7 @@ void Assembly::applyConstraints(Vector& u, double t) {
       for (int i = 0; i < 3; ++i) data[3 * n + i] = followers_[n].u[i];
 }
 
-bool Assembly::evaluate(const Vector& u, Vector* f, FEMatrix* W) {
+bool Assembly::evaluate(const Vector& u, Vector* f, FEMatrix* W, const Vector* z, Vector* Kz) {
   Kokkos::Timer timer;
   uOverlap_->doImport(u, *importer_, Tpetra::INSERT);
   {
@@ -495,8 +521,39 @@ bool Assembly::evaluate(const Vector& u, Vector* f, FEMatrix* W) {
     Kokkos::deep_copy(x_, hx);
     Kokkos::deep_copy(u_, hu);
   }
-  const bool tangent = W != nullptr;
-  for (auto& effect : effects_) effect->evaluate(x_, u_, tangent);
+  // The tangent goes straight from each kernel into W's local CRS values
+  // (and into K z for the predictor), entity by entity.
+  const bool action = W && z && Kz;
+  std::vector<Matrix> zLocal, KzLocal;  // per effect: z and K z per entity
+  if (W) {
+    W->beginAssembly();
+    W->setAllToScalar(0.0);
+    const auto values = W->getLocalMatrixDevice().values;
+    for (auto& sink : sinks_) sink.values = values;
+  }
+  if (action) {
+    if (zOverlap_.is_null()) zOverlap_ = rcp(new Vector(overlapDofMap_));
+    zOverlap_->doImport(*z, *importer_, Tpetra::INSERT);
+    auto zd = zOverlap_->getData();
+    for (size_t i = 0; i < effects_.size(); ++i) {
+      const auto& L = effects_[i]->local();
+      KzLocal.emplace_back("K z", L.dofs.extent(0), L.dofs.extent(1));  // zero for entities without a tangent
+      if (!L.stiff) {
+        zLocal.emplace_back();
+        continue;
+      }
+      auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.dofs);
+      zLocal.emplace_back("z", dofs.extent(0), dofs.extent(1));
+      auto hz = Kokkos::create_mirror_view(zLocal.back());
+      for (size_t e = 0; e < dofs.extent(0); ++e)
+        for (size_t k = 0; k < dofs.extent(1); ++k) hz(e, k) = zd[overlapLid(dofs(e, k))];
+      Kokkos::deep_copy(zLocal.back(), hz);
+      sinks_[i].z = zLocal.back(), sinks_[i].Kz = KzLocal.back();
+    }
+  }
+  for (size_t i = 0; i < effects_.size(); ++i)
+    effects_[i]->evaluate(x_, u_, W && effects_[i]->local().stiff ? &sinks_[i] : nullptr);
+  for (auto& sink : sinks_) sink.values = {}, sink.z = {}, sink.Kz = {};  // no stale views kept
 
   double minJ = 1e300;
   auto elementMinJ = bricks_->minJacobian;
@@ -542,34 +599,20 @@ bool Assembly::evaluate(const Vector& u, Vector* f, FEMatrix* W) {
     }
   }
 
-  if (W) {
-    // Element matrices are added straight into the local CRS values at their
-    // precomputed offsets, in a parallel loop (atomic: entities share entries;
-    // not where the loop runs on one thread, where an atomic add of a double
-    // is a compare-and-swap loop for nothing).
-    constexpr bool kSerial = std::is_same_v<ExecSpace, Kokkos::Serial>;
-    W->beginAssembly();
-    W->setAllToScalar(0.0);
-    const auto values = W->getLocalMatrixDevice().values;
-    for (size_t i = 0; i < effects_.size(); ++i) {
-      const auto& L = effects_[i]->local();
-      if (L.K.extent(0) == 0) continue;
-      const auto K = L.K;
-      const auto active = L.active;
-      const auto offsets = entryOffsets_[i];
-      const int n = int(K.extent(1));
-      Kokkos::parallel_for(
-          "scatter", Kokkos::RangePolicy<ExecSpace>(0, K.extent(0)), KOKKOS_LAMBDA(int e) {
-            if (active.extent(0) && !active(e)) return;
-            for (int k = 0; k < n; ++k)
-              for (int l = 0; l < n; ++l) {
-                const int o = offsets(e, k, l);
-                if (o < 0) continue;
-                if constexpr (kSerial) values(o) += K(e, k, l);
-                else Kokkos::atomic_add(&values(o), K(e, k, l));
-              }
-          });
+  if (action) {
+    // K z: summed like a residual, then carried to the cores' unknowns.
+    sumEntityVectors(KzLocal);
+    auto ro = residual_->getData(0);
+    const auto sums = coreSums(ro);
+    auto yd = Kz->getDataNonConst();
+    for (LO d = 0; d < LO(yd.size()); ++d) {
+      const int a = assemblyDof(d);
+      yd[d] = a < nodeDofs_ ? ro[d] : (a - nodeDofs_) % 6 < 4 ? sums[(a - nodeDofs_) / 6][(a - nodeDofs_) % 6] : 0.0;
     }
+  }
+
+  if (W) {
+    const auto values = W->getLocalMatrixDevice().values;
     const auto diagonal = constrainedDiagonal_;
     Kokkos::parallel_for(
         "constrained diagonal", Kokkos::RangePolicy<ExecSpace>(0, diagonal.extent(0)),
@@ -597,41 +640,6 @@ void Assembly::sumEntityVectors(const std::vector<Matrix>& values) {
     }
   }
   residual_->endAssembly();  // one export: shared rows added into their owners
-}
-
-void Assembly::tangentAction(const Vector& z, Vector& y) {
-  uOverlap_->doImport(z, *importer_, Tpetra::INSERT);
-  auto zd = uOverlap_->getData();
-  std::vector<Matrix> Kz;
-  for (const auto& effect : effects_) {
-    const auto& L = effect->local();
-    auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.dofs);
-    auto K = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.K);
-    Matrix out("K z", dofs.extent(0), dofs.extent(1));
-    auto ho = Kokkos::create_mirror_view(out);
-    auto active = activeOnHost(L);
-    const bool stiff = L.K.extent(0) > 0;
-    for (size_t e = 0; e < dofs.extent(0); ++e)
-      for (size_t k = 0; k < dofs.extent(1); ++k) {
-        double s = 0;
-        if (!stiff || (active.size() && !active(e))) {
-          ho(e, k) = 0;
-          continue;
-        }
-        for (size_t l = 0; l < dofs.extent(1); ++l) s += K(e, k, l) * zd[overlapLid(dofs(e, l))];
-        ho(e, k) = s;
-      }
-    Kokkos::deep_copy(out, ho);
-    Kz.push_back(out);
-  }
-  sumEntityVectors(Kz);
-  auto ro = residual_->getData(0);
-  const auto sums = coreSums(ro);  // K z at the face nodes, carried to the cores' unknowns
-  auto yd = y.getDataNonConst();
-  for (LO d = 0; d < LO(yd.size()); ++d) {
-    const int a = assemblyDof(d);
-    yd[d] = a < nodeDofs_ ? ro[d] : (a - nodeDofs_) % 6 < 4 ? sums[(a - nodeDofs_) / 6][(a - nodeDofs_) % 6] : 0.0;
-  }
 }
 
 void Assembly::constraintIncrement(Vector& z, double t0, double t1) const {

@@ -106,12 +106,11 @@ class Assembly {
   // null) and the tangent W (if not null). Constrained rows: f = 0 and W has the
   // identity in row and column (u already holds the prescribed values, so the
   // Newton update there is zero and the elimination keeps W's structure).
+  // With z and Kz (and W): also Kz = K z with the element tangents of this
+  // evaluation, no constraints applied: the load a prescribed increment z
+  // causes, for the step predictor (the tangents are not kept to form it later).
   // Returns false if an element is inverted (det F <= 0 at a Gauss point).
-  bool evaluate(const Vector& u, Vector* f, FEMatrix* W);
-
-  // y = K z with the element tangents of the last evaluation (no constraints
-  // applied): the load a prescribed increment z causes, for the step predictor.
-  void tangentAction(const Vector& z, Vector& y);
+  bool evaluate(const Vector& u, Vector* f, FEMatrix* W, const Vector* z = nullptr, Vector* Kz = nullptr);
   // z = prescribed displacement increment from t0 to t1 (zero on free dofs).
   void constraintIncrement(Vector& z, double t0, double t1) const;
 
@@ -135,7 +134,7 @@ class Assembly {
 
  private:
   void sumEntityVectors(const std::vector<Matrix>& values);  // into residual_ (owned)
-  void findEntryOffsets();
+  void buildTangentSinks();
   // Assembly dofs <-> local ids of the Tpetra maps. Overlapped order: owned
   // node dofs, (rank 0) the cores' dofs, ghost node dofs, (other ranks) the
   // cores' dofs: Tpetra's finite-element objects need the owned ids first.
@@ -185,15 +184,16 @@ class Assembly {
   Constraints constraints_;
   RCP<FEGraph> graph_;
   std::vector<std::vector<LO>> columns_;  // per effect: [entity * dofs + k] matrix column ids
-  // Per effect: where each element-matrix entry (entity, k, l) lands in the
-  // values of the local (owned plus shared) CRS matrix, -1 for entries of
-  // constrained rows or columns. Found once, so assembly is a plain scatter.
-  // 4-byte offsets: half the memory and traffic of 8-byte ones (G1 8x on 2
-  // ranks: 200 MB a rank); a rank's matrix holds fewer than 2^31 entries.
-  std::vector<Kokkos::View<int***, Kokkos::LayoutRight>> entryOffsets_;
+  // Per effect: where its kernel puts each entity's tangent (effects.hpp): the
+  // CRS offsets of its 3-column blocks and held columns, found once (4-byte
+  // offsets, one per block: a sixth of the memory and traffic of one 8-byte
+  // offset per entry; a rank's matrix holds fewer than 2^31 entries), and the
+  // kept copies for the rigid-core chain rule. Each evaluation adds the
+  // matrix's values (and the predictor's K z).
+  std::vector<TangentSink> sinks_;
   Kokkos::View<int*> constrainedDiagonal_;  // offsets of the owned constrained diagonals
   RCP<const Tpetra::Import<>> importer_;
-  RCP<Vector> uOverlap_;
+  RCP<Vector> uOverlap_, zOverlap_;
   RCP<Tpetra::FEMultiVector<>> residual_;
   std::vector<double> rawOwnedResidual_;
   NodalVectors x_, u_;

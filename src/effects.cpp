@@ -14,9 +14,9 @@
 
 namespace capstan {
 
-void Effect::evaluate(const NodalVectors& x, const NodalVectors& u, bool tangent) {
+void Effect::evaluate(const NodalVectors& x, const NodalVectors& u, const TangentSink* sink) {
   Kokkos::Timer timer;
-  launch(x, u, tangent);
+  launch(x, u, sink != nullptr, sink ? *sink : TangentSink{});
   Kokkos::fence();
   seconds_ += timer.seconds();
   ++launches_;
@@ -84,7 +84,7 @@ BrickEffect::BrickEffect(const Mesh& mesh, double c, double penalty, double volu
   minJacobian = Kokkos::View<double*>("minJ", ne);
   local_.dofs = dofsOf(nodes_);
   local_.R = Matrix("brick R", ne, 24);
-  local_.K = Tensor3("brick K", ne, 24, 24);
+  local_.stiff = true;
   auto X = X_;
   auto V = referenceVolume;
   Kokkos::parallel_for(
@@ -97,11 +97,10 @@ BrickEffect::BrickEffect(const Mesh& mesh, double c, double penalty, double volu
       });
 }
 
-void BrickEffect::launch(const NodalVectors& x, const NodalVectors&, bool tangent) {
+void BrickEffect::launch(const NodalVectors& x, const NodalVectors&, bool tangent, const TangentSink& sink) {
   auto nodes = nodes_;
   auto X = X_;
   auto R = local_.R;
-  auto K = local_.K;
   auto V = referenceVolume, pbar = pressureAnchor, p = pressure, v = volume, minJ = minJacobian;
   const double c = c_, eps = penalty_;
   Kokkos::parallel_for(
@@ -110,8 +109,9 @@ void BrickEffect::launch(const NodalVectors& x, const NodalVectors&, bool tangen
         double Xe[8][3], xe[8][3];
         gatherBrick(e, nodes, X, x, Xe, xe);
         kernels::BrickState st;
-        kernels::brickResidualTangent(Xe, xe, V(e), pbar(e), c, eps, &R(e, 0),
-                                      tangent ? &K(e, 0, 0) : nullptr, st);
+        double K[24 * 24];
+        kernels::brickResidualTangent(Xe, xe, V(e), pbar(e), c, eps, &R(e, 0), tangent ? K : nullptr, st);
+        if (tangent) sink.operator()<24>(e, K);
         p(e) = st.pressure;
         v(e) = st.volume;
         minJ(e) = st.minJ;
@@ -193,14 +193,13 @@ FoundationEffect::FoundationEffect(const std::string& name, const Mesh& mesh,
   for (int i = 0; i < 3; ++i) mask_[i] = components[i] ? 1 : 0;
   local_.dofs = dofsOf(nodes_);
   local_.R = Matrix("foundation R", nf, 12);
-  local_.K = Tensor3("foundation K", nf, 12, 12);
+  local_.stiff = true;
 }
 
-void FoundationEffect::launch(const NodalVectors&, const NodalVectors& u, bool) {
+void FoundationEffect::launch(const NodalVectors&, const NodalVectors& u, bool tangent, const TangentSink& sink) {
   auto nodes = nodes_;
   auto X = X_;
   auto R = local_.R;
-  auto K = local_.K;
   const double k = k_;
   const int m0 = mask_[0], m1 = mask_[1], m2 = mask_[2];
   Kokkos::parallel_for(
@@ -212,7 +211,9 @@ void FoundationEffect::launch(const NodalVectors&, const NodalVectors& u, bool) 
             uf[a][i] = u(nodes(f, a), i);
           }
         const int mask[3] = {m0, m1, m2};
-        kernels::foundationResidualTangent(Xf, uf, k, mask, &R(f, 0), &K(f, 0, 0));
+        double K[12 * 12];
+        kernels::foundationResidualTangent(Xf, uf, k, mask, &R(f, 0), K);
+        if (tangent) sink.operator()<12>(f, K);
       });
 }
 
@@ -248,7 +249,7 @@ BodyForceEffect::BodyForceEffect(const Mesh& mesh, std::array<double, 3> b, doub
 }
 
 // A dead load ramped with time: the loads integrated once, scaled.
-void BodyForceEffect::launch(const NodalVectors&, const NodalVectors&, bool) {
+void BodyForceEffect::launch(const NodalVectors&, const NodalVectors&, bool, const TangentSink&) {
   auto R = local_.R;
   auto load = fullLoad_;
   const double scale = scale_;
@@ -277,7 +278,7 @@ ContactEffect::ContactEffect(const std::string& name, const Mesh& mesh,
   points_ = decltype(points_)("contact points", nf, kernels::kMaxFacePoints);
   local_.dofs = dofsOf(nodes_);
   local_.R = Matrix("contact R", nf, 12);
-  local_.K = Tensor3("contact K", nf, 12, 12);
+  local_.stiff = true;
   local_.active = Kokkos::View<int*>("contact active", nf);
   // The smallest candidate face edge over all ranks sets the defaults.
   double h = 1e300;
@@ -316,11 +317,10 @@ kernels::Cylinder ContactEffect::cylinder() const {
   return cyl;
 }
 
-void ContactEffect::launch(const NodalVectors& x, const NodalVectors&, bool tangent) {
+void ContactEffect::launch(const NodalVectors& x, const NodalVectors&, bool tangent, const TangentSink& sink) {
   auto nodes = nodes_;
   auto X = X_;
   auto R = local_.R;
-  auto K = local_.K;
   auto active = local_.active;
   auto lambda = lambda_;
   auto pts = points_;
@@ -338,9 +338,11 @@ void ContactEffect::launch(const NodalVectors& x, const NodalVectors&, bool tang
             xf[a][i] = x(nodes(f, a), i);
           }
         kernels::ContactPoint p[kernels::kMaxFacePoints];
+        double K[12 * 12];
         active(f) = kernels::contactFaceResidualTangent(
             Xf, xf, cyl, eps, kappa, &lambda(f * kernels::kMaxFacePoints), rule, &R(f, 0),
-            tangent ? &K(f, 0, 0) : nullptr, p, geometric);
+            tangent ? K : nullptr, p, geometric);
+        if (tangent && active(f)) sink.operator()<12>(f, K);
         for (int q = 0; q < kernels::facePointCount(rule); ++q) {
           pts(f, q, kGap) = p[q].gap;
           pts(f, q, kPressure) = p[q].pressure;
@@ -507,7 +509,7 @@ FrictionEffect::FrictionEffect(const std::string& name, const Mesh& mesh,
   points_ = decltype(points_)("friction points", nf, kernels::kMaxFacePoints);
   local_.dofs = dofsOf(nodes_);
   local_.R = Matrix("friction R", nf, 12);
-  local_.K = Tensor3("friction K", nf, 12, 12);
+  local_.stiff = true;
   local_.active = Kokkos::View<int*>("friction active", nf);
   // The body starts at its reference positions, with no friction traction.
   auto X = X_;
@@ -533,11 +535,10 @@ void FrictionEffect::setInterval(double tStart, double tEnd) {
   parameters_.v = settings_.regularization * (dt > 0 ? dt : 1.0);
 }
 
-void FrictionEffect::launch(const NodalVectors& x, const NodalVectors&, bool tangent) {
+void FrictionEffect::launch(const NodalVectors& x, const NodalVectors&, bool tangent, const TangentSink& sink) {
   auto nodes = nodes_;
   auto X = X_;
   auto R = local_.R;
-  auto K = local_.K;
   auto active = local_.active;
   auto lambda = contact_.normalMultipliers();
   auto h = history_;
@@ -559,10 +560,12 @@ void FrictionEffect::launch(const NodalVectors& x, const NodalVectors&, bool tan
             xn[a][i] = h(f * kHistoryPerFace + 3 * a + i);
           }
         kernels::FrictionPoint p[kernels::kMaxFacePoints];
+        double K[12 * 12];
         active(f) = kernels::frictionFaceResidualTangent(
             Xf, xf, xn, cyl, eps, kappa, &lambda(f * kernels::kMaxFacePoints), rule, fp,
             useMultipliers ? &lambdaT(f * kernels::kMaxFacePoints * 3) : &h(f * kHistoryPerFace + 12),
-            &R(f, 0), tangent ? &K(f, 0, 0) : nullptr, p);
+            &R(f, 0), tangent ? K : nullptr, p);
+        if (tangent && active(f)) sink.operator()<12>(f, K);
         for (int q = 0; q < kernels::facePointCount(rule); ++q) {
           for (int i = 0; i < 3; ++i) pts(f, q, kTraction + i) = p[q].traction[i];
           pts(f, q, kNormal) = p[q].normal;

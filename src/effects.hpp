@@ -1,7 +1,8 @@
 // Physical effects: each is a small object the scene switches on, owning its
 // data and launching its Kokkos kernel over its entities (bricks or faces). All
-// of them hand the same thing to the one assembly path: per-entity dof ids,
-// residual and tangent (LocalSystem).
+// of them hand the same things to the one assembly path: per-entity dof ids and
+// residuals (LocalSystem), and each entity's tangent to the assembly's
+// TangentSink as it is formed.
 #pragma once
 
 #include <Kokkos_Core.hpp>
@@ -11,6 +12,7 @@
 
 #include <array>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace capstan {
@@ -27,11 +29,65 @@ using NodalVectors = Kokkos::View<double* [3], Kokkos::LayoutRight>;
 struct LocalSystem {
   IntMatrix dofs;  // [entity][k]: overlapped dof ids (3 * node + component)
   Matrix R;        // [entity][k]
-  Tensor3 K;       // [entity][k][l]; empty for effects without stiffness (dead loads)
+  bool stiff = false;  // whether the entities have a tangent (dead loads have none)
   // Optional: entities with active(e) == 0 contribute nothing this evaluation
   // (contact faces away from the capstan); empty = all active. The matrix
   // graph still holds them, so the sparsity pattern never changes.
   Kokkos::View<int*> active;
+};
+
+// What a kernel does with an active entity's tangent K_e (n x n, row-major,
+// dof 3a+i) right after forming it, while it is still in cache. Element
+// tangents are not stored: on G1 8x they took 790 MB, and the scatter's
+// reading them back from memory was most of its time (docs/performance.md,
+// "Assembly without stored element matrices"). Each part is off when empty:
+//   - values: K_e is added into the local CRS values of Newton's matrix (owned
+//     plus shared rows) at offsets found once: rowBlock(e, k * n/3 + b) is the
+//     offset of column 3b in row k (its 3 columns follow it), -1 where row k
+//     is held; bit l of heldColumns(e) set: column l is held, not added;
+//   - z, Kz: Kz(e, k) = sum_l K_e(k, l) z(e, l), the step predictor's K z;
+//   - keepSlot, kept: a copy of K_e in kept(keepSlot(e)) where keepSlot(e) >= 0
+//     (entities with a rigid core's face node, for the chain rule).
+struct TangentSink {
+  Kokkos::View<double*> values;
+  Kokkos::View<int**, Kokkos::LayoutRight> rowBlock;
+  Kokkos::View<int*> heldColumns;
+  Matrix z, Kz;
+  Kokkos::View<int*> keepSlot;
+  Kokkos::View<double***, Kokkos::LayoutRight> kept;
+
+  template <int n>
+  KOKKOS_INLINE_FUNCTION void operator()(int e, const double* K) const {
+    if (values.extent(0)) {
+      // On one thread (Serial) a plain add: there an atomic add of a double is
+      // a compare-and-swap loop for nothing.
+      constexpr bool serial = std::is_same_v<Kokkos::DefaultExecutionSpace, Kokkos::Serial>;
+      constexpr int nb = n / 3;
+      double* const v = values.data();
+      const int* const rows = &rowBlock(e, 0);
+      const int held = heldColumns(e);
+      for (int k = 0; k < n; ++k) {
+        const int* const o = rows + k * nb;
+        if (o[0] < 0) continue;  // a held row
+        const double* const Kk = K + k * n;
+        for (int b = 0; b < nb; ++b)
+          for (int j = 0; j < 3; ++j) {
+            if (held && (held & (1 << (3 * b + j)))) continue;
+            if constexpr (serial) v[o[b] + j] += Kk[3 * b + j];
+            else Kokkos::atomic_add(&v[o[b] + j], Kk[3 * b + j]);
+          }
+      }
+    }
+    if (z.extent(0))
+      for (int k = 0; k < n; ++k) {
+        double s = 0;
+        for (int l = 0; l < n; ++l) s += K[k * n + l] * z(e, l);
+        Kz(e, k) = s;
+      }
+    if (keepSlot.extent(0) && keepSlot(e) >= 0)
+      for (int k = 0; k < n; ++k)
+        for (int l = 0; l < n; ++l) kept(keepSlot(e), k, l) = K[k * n + l];
+  }
 };
 
 // An effect's constraints, linearised at the last evaluation, for the
@@ -59,8 +115,9 @@ class Effect {
   explicit Effect(std::string name) : name_(std::move(name)) {}
   virtual ~Effect() = default;
   const std::string& name() const { return name_; }
-  // Residual (and tangent) at current positions x and displacements u (overlapped nodes).
-  void evaluate(const NodalVectors& x, const NodalVectors& u, bool tangent);
+  // Residual at current positions x and displacements u (overlapped nodes),
+  // and with a sink the tangent, which goes to the sink entity by entity.
+  void evaluate(const NodalVectors& x, const NodalVectors& u, const TangentSink* sink);
   const LocalSystem& local() const { return local_; }
   long launches() const { return launches_; }
   double seconds() const { return seconds_; }
@@ -101,7 +158,8 @@ class Effect {
   virtual std::string constraintName() const { return name(); }
 
  protected:
-  virtual void launch(const NodalVectors& x, const NodalVectors& u, bool tangent) = 0;
+  // tangent: whether to form the tangent and hand it to sink.
+  virtual void launch(const NodalVectors& x, const NodalVectors& u, bool tangent, const TangentSink& sink) = 0;
   LocalSystem local_;
 
  private:
@@ -139,7 +197,7 @@ class BrickEffect : public Effect {
   std::string constraintName() const override { return "volume change"; }
 
  protected:
-  void launch(const NodalVectors& x, const NodalVectors& u, bool tangent) override;
+  void launch(const NodalVectors& x, const NodalVectors& u, bool tangent, const TangentSink& sink) override;
 
  private:
   Kokkos::View<int* [8], Kokkos::LayoutRight> nodes_;
@@ -156,7 +214,7 @@ class FoundationEffect : public Effect {
   std::array<double, 3> localForceOnBody() const;
 
  protected:
-  void launch(const NodalVectors& x, const NodalVectors& u, bool tangent) override;
+  void launch(const NodalVectors& x, const NodalVectors& u, bool tangent, const TangentSink& sink) override;
 
  private:
   Kokkos::View<int* [4], Kokkos::LayoutRight> nodes_;
@@ -166,14 +224,14 @@ class FoundationEffect : public Effect {
 };
 
 // Dead body force b per unit reference volume on every brick (Loads/Body Force),
-// ramped with time: b t / endTime. No stiffness (local().K is empty).
+// ramped with time: b t / endTime. No stiffness (local().stiff is false).
 class BodyForceEffect : public Effect {
  public:
   BodyForceEffect(const Mesh& mesh, std::array<double, 3> b, double endTime);
   void setInterval(double, double tEnd) override { scale_ = tEnd / endTime_; }
 
  protected:
-  void launch(const NodalVectors& x, const NodalVectors& u, bool tangent) override;
+  void launch(const NodalVectors& x, const NodalVectors& u, bool tangent, const TangentSink& sink) override;
 
  private:
   Matrix fullLoad_;  // the nodal loads of b itself, integrated once (they never change)
@@ -257,7 +315,7 @@ class ContactEffect : public Effect {
   size_t numFaces() const { return nodes_.extent(0); }
 
  protected:
-  void launch(const NodalVectors& x, const NodalVectors& u, bool tangent) override;
+  void launch(const NodalVectors& x, const NodalVectors& u, bool tangent, const TangentSink& sink) override;
 
  private:
   Kokkos::View<int* [4], Kokkos::LayoutRight> nodes_;
@@ -325,7 +383,7 @@ class FrictionEffect : public Effect {
                   std::vector<double>& slip) const;
 
  protected:
-  void launch(const NodalVectors& x, const NodalVectors& u, bool tangent) override;
+  void launch(const NodalVectors& x, const NodalVectors& u, bool tangent, const TangentSink& sink) override;
 
  private:
   const ContactEffect& contact_;

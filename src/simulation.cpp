@@ -304,12 +304,11 @@ void Run::predict(double t0, double t1, double bareResidual, StepRecord& rec) {
   // whole travel (friction assumes stick: the body follows the capstan, which
   // a slipping linearisation, with no stiffness along the slip, cannot see).
   for (const auto& e : assembly_->effects()) e->setPredicting(true);
-  const bool valid = assembly_->evaluate(*u_, &f, W.get());
+  const bool valid = assembly_->evaluate(*u_, &f, W.get(), &z, &Kz);
   if (!valid) {
     for (const auto& e : assembly_->effects()) e->setPredicting(false);
     return;
   }
-  assembly_->tangentAction(z, Kz);
   {
     auto r = rhs.getDataNonConst();
     auto fd = f.getData();
