@@ -325,6 +325,7 @@ void Assembly::buildTangentSinks() {
     TangentSink& sink = sinks_.back();
     auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.dofs);
     const size_t ne = dofs.extent(0), n = dofs.extent(1), nb = n / 3;
+    if (n > 30) throw std::logic_error("assembly: an entity has more than 30 dofs (the held-column mask is an int)");
     sink.rowBlock = decltype(sink.rowBlock)("tangent row blocks", ne, n * nb);
     sink.heldColumns = Kokkos::View<int*>("tangent held columns", ne);
     auto hb = Kokkos::create_mirror_view(sink.rowBlock);
@@ -523,7 +524,8 @@ bool Assembly::evaluate(const Vector& u, Vector* f, FEMatrix* W, const Vector* z
   }
   // The tangent goes straight from each kernel into W's local CRS values
   // (and into K z for the predictor), entity by entity.
-  const bool action = W && z && Kz;
+  if (bool(z) != bool(Kz) || (z && !W)) throw std::logic_error("assembly: K z needs z, Kz and the tangent W");
+  const bool action = z != nullptr;
   std::vector<Matrix> zLocal, KzLocal;  // per effect: z and K z per entity
   if (W) {
     W->beginAssembly();

@@ -38,9 +38,9 @@ struct LocalSystem {
 
 // What a kernel does with an active entity's tangent K_e (n x n, row-major,
 // dof 3a+i) right after forming it, while it is still in cache. Element
-// tangents are not stored: on G1 8x they took 790 MB, and the scatter's
-// reading them back from memory was most of its time (docs/performance.md,
-// "Assembly without stored element matrices"). Each part is off when empty:
+// tangents are not stored: on G1 8x on one rank they took 790 MB, and the run's
+// peak fell 18% without them (docs/performance.md, "Assembly without stored
+// element tangents"). Each part is off when empty:
 //   - values: K_e is added into the local CRS values of Newton's matrix (owned
 //     plus shared rows) at offsets found once: rowBlock(e, k * n/3 + b) is the
 //     offset of column 3b in row k (its 3 columns follow it), -1 where row k
