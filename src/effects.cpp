@@ -111,7 +111,7 @@ void BrickEffect::launch(const NodalVectors& x, const NodalVectors&, bool tangen
         kernels::BrickState st;
         double K[24 * 24];
         kernels::brickResidualTangent(Xe, xe, V(e), pbar(e), c, eps, &R(e, 0), tangent ? K : nullptr, st);
-        if (tangent) sink.operator()<24>(e, K);
+        if (tangent) sink.take<24>(e, K);
         p(e) = st.pressure;
         v(e) = st.volume;
         minJ(e) = st.minJ;
@@ -213,7 +213,7 @@ void FoundationEffect::launch(const NodalVectors&, const NodalVectors& u, bool t
         const int mask[3] = {m0, m1, m2};
         double K[12 * 12];
         kernels::foundationResidualTangent(Xf, uf, k, mask, &R(f, 0), K);
-        if (tangent) sink.operator()<12>(f, K);
+        if (tangent) sink.take<12>(f, K);
       });
 }
 
@@ -342,7 +342,7 @@ void ContactEffect::launch(const NodalVectors& x, const NodalVectors&, bool tang
         active(f) = kernels::contactFaceResidualTangent(
             Xf, xf, cyl, eps, kappa, &lambda(f * kernels::kMaxFacePoints), rule, &R(f, 0),
             tangent ? K : nullptr, p, geometric);
-        if (tangent && active(f)) sink.operator()<12>(f, K);
+        if (tangent && active(f)) sink.take<12>(f, K);
         for (int q = 0; q < kernels::facePointCount(rule); ++q) {
           pts(f, q, kGap) = p[q].gap;
           pts(f, q, kPressure) = p[q].pressure;
@@ -565,7 +565,7 @@ void FrictionEffect::launch(const NodalVectors& x, const NodalVectors&, bool tan
             Xf, xf, xn, cyl, eps, kappa, &lambda(f * kernels::kMaxFacePoints), rule, fp,
             useMultipliers ? &lambdaT(f * kernels::kMaxFacePoints * 3) : &h(f * kHistoryPerFace + 12),
             &R(f, 0), tangent ? K : nullptr, p);
-        if (tangent && active(f)) sink.operator()<12>(f, K);
+        if (tangent && active(f)) sink.take<12>(f, K);
         for (int q = 0; q < kernels::facePointCount(rule); ++q) {
           for (int i = 0; i < 3; ++i) pts(f, q, kTraction + i) = p[q].traction[i];
           pts(f, q, kNormal) = p[q].normal;

@@ -56,8 +56,9 @@ struct TangentSink {
   Kokkos::View<int*> keepSlot;
   Kokkos::View<double***, Kokkos::LayoutRight> kept;
 
+  // Entity e's tangent K (n x n): into the matrix, K z and the kept copy.
   template <int n>
-  KOKKOS_INLINE_FUNCTION void operator()(int e, const double* K) const {
+  KOKKOS_INLINE_FUNCTION void take(int e, const double* K) const {
     if (values.extent(0)) {
       // On one thread (Serial) a plain add: there an atomic add of a double is
       // a compare-and-swap loop for nothing.
