@@ -526,7 +526,7 @@ bool Assembly::evaluate(const Vector& u, Vector* f, FEMatrix* W, const Vector* z
   // (and into K z for the predictor), entity by entity.
   if (bool(z) != bool(Kz) || (z && !W)) throw std::logic_error("assembly: K z needs z, Kz and the tangent W");
   const bool action = z != nullptr;
-  std::vector<Matrix> zLocal, KzLocal;  // per effect: z and K z per entity
+  std::vector<Matrix> KzLocal;  // per effect: K z per entity (the sinks hold z per entity)
   if (W) {
     W->beginAssembly();
     W->setAllToScalar(0.0);
@@ -540,17 +540,14 @@ bool Assembly::evaluate(const Vector& u, Vector* f, FEMatrix* W, const Vector* z
     for (size_t i = 0; i < effects_.size(); ++i) {
       const auto& L = effects_[i]->local();
       KzLocal.emplace_back("K z", L.dofs.extent(0), L.dofs.extent(1));  // zero for entities without a tangent
-      if (!L.stiff) {
-        zLocal.emplace_back();
-        continue;
-      }
+      if (!L.stiff) continue;
       auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.dofs);
-      zLocal.emplace_back("z", dofs.extent(0), dofs.extent(1));
-      auto hz = Kokkos::create_mirror_view(zLocal.back());
+      Matrix zLocal("z", dofs.extent(0), dofs.extent(1));
+      auto hz = Kokkos::create_mirror_view(zLocal);
       for (size_t e = 0; e < dofs.extent(0); ++e)
         for (size_t k = 0; k < dofs.extent(1); ++k) hz(e, k) = zd[overlapLid(dofs(e, k))];
-      Kokkos::deep_copy(zLocal.back(), hz);
-      sinks_[i].z = zLocal.back(), sinks_[i].Kz = KzLocal.back();
+      Kokkos::deep_copy(zLocal, hz);
+      sinks_[i].z = zLocal, sinks_[i].Kz = KzLocal.back();
     }
   }
   for (size_t i = 0; i < effects_.size(); ++i)
