@@ -25,9 +25,10 @@ KOKKOS_INLINE_FUNCTION double quadAreaElement(const double X[4][3], double xi, d
 }
 
 // R[3a+i] = k m_i sum_b M_ab u_b,i ; K = k m_i delta_ik M_ab (m: component mask).
+// K null: the residual alone (line searches and constraint checks form no tangent).
 KOKKOS_INLINE_FUNCTION void foundationResidualTangent(const double X[4][3], const double u[4][3],
                                                       double k, const int mask[3],
-                                                      double R[12], double K[144]) {
+                                                      double R[12], double* K) {
   double M[4][4] = {};
   for (int q = 0; q < 4; ++q) {
     double N[4];
@@ -35,16 +36,17 @@ KOKKOS_INLINE_FUNCTION void foundationResidualTangent(const double X[4][3], cons
     for (int a = 0; a < 4; ++a)
       for (int b = 0; b < 4; ++b) M[a][b] += N[a] * N[b] * dA;
   }
-  for (int r = 0; r < 144; ++r) K[r] = 0;
   for (int a = 0; a < 4; ++a)
     for (int i = 0; i < 3; ++i) {
       double s = 0;
-      for (int b = 0; b < 4; ++b) {
-        s += M[a][b] * u[b][i];
-        K[(3 * a + i) * 12 + 3 * b + i] = mask[i] ? k * M[a][b] : 0.0;
-      }
+      for (int b = 0; b < 4; ++b) s += M[a][b] * u[b][i];
       R[3 * a + i] = mask[i] ? k * s : 0.0;
     }
+  if (!K) return;
+  for (int r = 0; r < 144; ++r) K[r] = 0;
+  for (int a = 0; a < 4; ++a)
+    for (int i = 0; i < 3; ++i)
+      for (int b = 0; b < 4; ++b) K[(3 * a + i) * 12 + 3 * b + i] = mask[i] ? k * M[a][b] : 0.0;
 }
 
 }  // namespace capstan::kernels

@@ -531,7 +531,8 @@ bool Assembly::evaluate(const Vector& u, Vector* f, FEMatrix* W, const Vector* z
     W->beginAssembly();
     W->setAllToScalar(0.0);
     const auto values = W->getLocalMatrixDevice().values;
-    for (auto& sink : sinks_) sink.values = values;
+    for (size_t i = 0; i < effects_.size(); ++i)
+      if (effects_[i]->local().stiff) sinks_[i].values = values;  // the others get no sink
   }
   if (action) {
     if (zOverlap_.is_null()) zOverlap_ = rcp(new Vector(overlapDofMap_));

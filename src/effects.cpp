@@ -212,7 +212,7 @@ void FoundationEffect::launch(const NodalVectors&, const NodalVectors& u, bool t
           }
         const int mask[3] = {m0, m1, m2};
         double K[12 * 12];
-        kernels::foundationResidualTangent(Xf, uf, k, mask, &R(f, 0), K);
+        kernels::foundationResidualTangent(Xf, uf, k, mask, &R(f, 0), tangent ? K : nullptr);
         if (tangent) sink.take<12>(f, K);
       });
 }

@@ -253,7 +253,9 @@ Partition autoPartition(int slowestCells, int ranks) {
 Partition partitionFor(const std::string& name, int slowestCells, int ranks) {
   if (name == "Slabs") return Partition::Slabs;
   if (name == "METIS") return Partition::Metis;
-  return autoPartition(slowestCells, ranks);
+  if (name == "Auto") return autoPartition(slowestCells, ranks);
+  // The scene reader accepts these three only, so anything else is a bug here.
+  throw std::logic_error("mesh: unknown Mesh/Partition '" + name + "'");
 }
 
 const char* partitionName(Partition partition) { return partition == Partition::Slabs ? "Slabs" : "METIS"; }

@@ -52,7 +52,8 @@ enum class Partition { Metis, Slabs };
 // 63.9 s); G1 4x, 12 layers, the same Krylov iterations (1,001 against 1,007).
 constexpr int kAutoSlabLayers = 16;
 Partition autoPartition(int slowestCells, int ranks);
-// Mesh/Partition's value: "METIS", "Slabs", or "Auto" (autoPartition), and back.
+// Mesh/Partition's value: "METIS", "Slabs", or "Auto" (autoPartition), and back;
+// any other name is a logic error (the scene reader rejects it with a message).
 Partition partitionFor(const std::string& name, int slowestCells, int ranks);
 const char* partitionName(Partition partition);
 

@@ -19,7 +19,7 @@ struct MeshSpec {
   double innerRadius = 0, outerRadius = 0, length = 0;
   double outerCellRatio = 1;             // radial grading (AnnulusGenerator)
   std::array<double, 3> fineSector{};    // {centre deg, width deg, fraction of cells}
-  std::string partition = "METIS";       // over the MPI ranks: METIS | Slabs
+  std::string partition = "Auto";        // over the MPI ranks: Auto | METIS | Slabs (partitionFor)
   std::vector<std::string> faceNames() const;
 };
 

@@ -204,6 +204,7 @@ TEST(Partition, AutoPicksThickSlabsOnly) {
   EXPECT_EQ(partitionFor("Auto", 24, 2), Partition::Metis);
   EXPECT_EQ(partitionFor("METIS", 48, 2), Partition::Metis);
   EXPECT_EQ(partitionFor("Slabs", 8, 2), Partition::Slabs);
+  EXPECT_THROW(partitionFor("slabs", 48, 2), std::logic_error);
   EXPECT_STREQ(partitionName(Partition::Slabs), "Slabs");
   EXPECT_STREQ(partitionName(Partition::Metis), "METIS");
   BoxGenerator gen({0, 0, 0}, {1, 1, 1}, {2, 2, 2});
