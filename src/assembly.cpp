@@ -532,7 +532,7 @@ bool Assembly::evaluate(const Vector& u, Vector* f, FEMatrix* W, const Vector* z
     W->setAllToScalar(0.0);
     const auto values = W->getLocalMatrixDevice().values;
     for (size_t i = 0; i < effects_.size(); ++i)
-      if (effects_[i]->local().stiff) sinks_[i].values = values;  // the others get no sink
+      if (effects_[i]->local().stiff) sinks_[i].values = values;  // the others evaluate without a sink
   }
   if (action) {
     if (zOverlap_.is_null()) zOverlap_ = rcp(new Vector(overlapDofMap_));
