@@ -1,0 +1,362 @@
+// MumpsSolver: see direct_solver.hpp.
+#include "direct_solver.hpp"
+
+#include <Teuchos_DefaultMpiComm.hpp>
+#include <dmumps_c.h>
+#include <metis.h>
+#include <mpi.h>
+
+#include <algorithm>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace capstan {
+
+namespace {
+
+// MUMPS' 1-based ICNTL / INFOG numbering, as in its manual.
+inline MUMPS_INT& ICNTL(DMUMPS_STRUC_C& id, int i) { return id.icntl[i - 1]; }
+inline MUMPS_INT INFOG(const DMUMPS_STRUC_C& id, int i) { return id.infog[i - 1]; }
+
+const char* explainInfog1(int e) {
+  switch (e) {
+    case -5: case -7: case -13: return " (memory allocation failed)";
+    case -6: return " (matrix is structurally singular)";
+    case -8: case -9: case -14: case -15: case -17: case -20:
+      return " (working space too small)";
+    case -10: return " (matrix is numerically singular)";
+    case -16: return " (N out of range)";
+    default: return "";
+  }
+}
+
+MPI_Comm rawComm(const Teuchos::Comm<int>& comm) {
+  auto mpi = dynamic_cast<const Teuchos::MpiComm<int>*>(&comm);
+  return mpi ? (*mpi->getRawMpiComm())() : MPI_COMM_SELF;
+}
+
+// True on every rank if it is true on any.
+bool anyRank(bool local, MPI_Comm comm) {
+  int in = local ? 1 : 0, out = 0;
+  MPI_Allreduce(&in, &out, 1, MPI_INT, MPI_MAX, comm);
+  return out != 0;
+}
+
+}  // namespace
+
+struct MumpsSolver::Impl {
+  DMUMPS_STRUC_C id{};
+  MPI_Comm comm = MPI_COMM_NULL;  // the user's communicator (not owned)
+  int rank = 0, size = 1;
+
+  // The pattern of the last analysis in global ids (this rank's rows), to tell
+  // whether the next matrix has the same one, and its scratch twin.
+  std::vector<GO> rowGid, colGid, newRowGid, newColGid;
+  std::vector<std::size_t> rowPtr, newRowPtr;
+
+  // What MUMPS reads: 1-based global row / column numbers and the values.
+  // Rows are numbered rank by rank in local order (rank r's rows are
+  // offset[r] + 1 ... offset[r] + count[r]), columns alike by their owner.
+  std::vector<MUMPS_INT> irn, jcn;
+  std::vector<double> a;
+  std::vector<int> counts, offsets;  // rows per rank, first row - 1 per rank
+  int nLocal = 0, nGlobal = 0;
+  RCP<const Map> rowMap;
+
+  std::vector<MUMPS_INT> permIn;  // rank 0: METIS' ordering, 1-based
+  std::vector<double> rhs;        // rank 0: the centralised right-hand sides
+};
+
+MumpsSolver::MumpsSolver(const MumpsOptions& options) : options_(options) {}
+
+MumpsSolver::~MumpsSolver() {
+  if (!impl_) return;
+  int finalized = 0;
+  MPI_Finalized(&finalized);
+  if (finalized) return;  // too late to free MUMPS' memory collectively
+  impl_->id.job = -2;
+  dmumps_c(&impl_->id);
+}
+
+void MumpsSolver::initialize(const Teuchos::Comm<int>& comm) {
+  int initialized = 0;
+  MPI_Initialized(&initialized);
+  if (!initialized) throw std::logic_error("MumpsSolver: MPI is not initialised");
+  auto impl = std::make_unique<Impl>();
+  impl->comm = rawComm(comm);
+  MPI_Comm_rank(impl->comm, &impl->rank);
+  MPI_Comm_size(impl->comm, &impl->size);
+  DMUMPS_STRUC_C& id = impl->id;
+  id.comm_fortran = static_cast<MUMPS_INT>(MPI_Comm_c2f(impl->comm));  // MUMPS is Fortran inside
+  id.par = 1;  // the host (rank 0) works too
+  id.sym = 0;  // unsymmetric: friction
+  id.job = -1;
+  dmumps_c(&id);
+  if (INFOG(id, 1) < 0)
+    throw std::runtime_error("MUMPS initialisation failed: INFOG(1) = " + std::to_string(INFOG(id, 1)));
+  impl_ = std::move(impl);  // from here on the destructor frees MUMPS' instance
+
+  if (options_.verbose) {
+    ICNTL(id, 1) = 6, ICNTL(id, 2) = 0, ICNTL(id, 3) = 6, ICNTL(id, 4) = 2;
+  } else {
+    ICNTL(id, 1) = -1, ICNTL(id, 2) = -1, ICNTL(id, 3) = -1, ICNTL(id, 4) = 0;
+  }
+  ICNTL(id, 18) = 3;  // distributed assembled matrix, pattern at analysis, values at factorisation
+  ICNTL(id, 20) = 0;  // dense right-hand sides on the host
+  ICNTL(id, 21) = 0;  // centralised solution (overwrites the right-hand sides)
+  ICNTL(id, 28) = 1;  // sequential analysis: Debian's build has neither ParMETIS nor PT-SCOTCH
+  if (options_.workspaceIncreasePercent >= 0) ICNTL(id, 14) = options_.workspaceIncreasePercent;
+}
+
+bool MumpsSolver::extractPattern(const CrsMatrix& A) {
+  Impl& m = *impl_;
+  const auto& rowMap = *A.getRowMap();
+  const auto& colMap = *A.getColMap();
+  const LO nRows = static_cast<LO>(A.getNodeNumRows());
+  m.newRowGid.resize(nRows);
+  m.newRowPtr.resize(nRows + 1);
+  m.newColGid.clear();
+  m.a.clear();
+  m.newRowPtr[0] = 0;
+  CrsMatrix::local_inds_host_view_type inds;
+  CrsMatrix::values_host_view_type vals;
+  for (LO r = 0; r < nRows; ++r) {
+    A.getLocalRowView(r, inds, vals);
+    m.newRowGid[r] = rowMap.getGlobalElement(r);
+    for (std::size_t k = 0; k < inds.extent(0); ++k) {
+      m.newColGid.push_back(colMap.getGlobalElement(inds(k)));
+      m.a.push_back(vals(k));
+    }
+    m.newRowPtr[r + 1] = m.newColGid.size();
+  }
+  const bool changed = m.newRowGid != m.rowGid || m.newRowPtr != m.rowPtr || m.newColGid != m.colGid;
+  if (changed) {
+    std::swap(m.newRowGid, m.rowGid);
+    std::swap(m.newRowPtr, m.rowPtr);
+    std::swap(m.newColGid, m.colGid);
+  }
+  return changed;
+}
+
+void MumpsSolver::factor(const CrsMatrix& A) {
+  if (!A.isFillComplete() || A.isGloballyIndexed())
+    throw std::invalid_argument("MumpsSolver::factor: the matrix must be fill complete");
+  if (!impl_) {
+    initialize(*A.getComm());
+  } else {
+    int cmp = MPI_UNEQUAL;
+    MPI_Comm_compare(impl_->comm, rawComm(*A.getComm()), &cmp);
+    if (cmp != MPI_IDENT && cmp != MPI_CONGRUENT)
+      throw std::invalid_argument("MumpsSolver::factor: the matrix is on another communicator than the first one");
+  }
+  factored_ = false;
+  const bool changed = extractPattern(A);
+  if (anyRank(changed || !analysed_, impl_->comm)) analyse(A);
+  impl_->rowMap = A.getRowMap();
+  runFactorization();
+}
+
+void MumpsSolver::analyse(const CrsMatrix& A) {
+  Impl& m = *impl_;
+  analysed_ = false;
+  const double t0 = MPI_Wtime();
+  const auto rowMap = A.getRowMap();
+  const bool square = rowMap->isSameAs(*A.getDomainMap()) && rowMap->isSameAs(*A.getRangeMap()) &&
+                      rowMap->isOneToOne();
+  if (!square)
+    throw std::invalid_argument(
+        "MumpsSolver::factor: the matrix' row, domain and range maps must be one and the same "
+        "one-to-one map");
+  if (A.getGlobalNumRows() > static_cast<std::size_t>(std::numeric_limits<MUMPS_INT>::max()))
+    throw std::invalid_argument("MumpsSolver::factor: too many rows for 32-bit MUMPS");
+
+  // Row numbering: rank by rank.
+  m.nLocal = static_cast<int>(rowMap->getNodeNumElements());
+  m.counts.assign(m.size, 0);
+  m.offsets.assign(m.size, 0);
+  MPI_Allgather(&m.nLocal, 1, MPI_INT, m.counts.data(), 1, MPI_INT, m.comm);
+  for (int p = 1; p < m.size; ++p) m.offsets[p] = m.offsets[p - 1] + m.counts[p - 1];
+  m.nGlobal = m.offsets.back() + m.counts.back();
+
+  // Column numbering: by the owning rank and the owner's local index.
+  const auto& colMap = *A.getColMap();
+  const auto colGids = colMap.getNodeElementList();
+  std::vector<int> owner(colGids.size());
+  std::vector<LO> ownerLid(colGids.size());
+  const auto status = rowMap->getRemoteIndexList(colGids, Teuchos::arrayViewFromVector(owner),
+                                                 Teuchos::arrayViewFromVector(ownerLid));
+  if (anyRank(status != Tpetra::AllIDsPresent, m.comm))
+    throw std::invalid_argument("MumpsSolver::factor: a column id is not a row id");
+  std::vector<MUMPS_INT> colIndex(colGids.size());
+  for (std::size_t c = 0; c < colIndex.size(); ++c) colIndex[c] = m.offsets[owner[c]] + ownerLid[c] + 1;
+
+  const std::size_t nnz = m.colGid.size();
+  m.irn.resize(nnz);
+  m.jcn.resize(nnz);
+  CrsMatrix::local_inds_host_view_type inds;
+  CrsMatrix::values_host_view_type vals;
+  for (int r = 0; r < m.nLocal; ++r) {
+    A.getLocalRowView(r, inds, vals);
+    const std::size_t k0 = m.rowPtr[r];
+    for (std::size_t k = 0; k < inds.extent(0); ++k) {
+      m.irn[k0 + k] = m.offsets[m.rank] + r + 1;
+      m.jcn[k0 + k] = colIndex[inds(k)];
+    }
+  }
+
+  DMUMPS_STRUC_C& id = m.id;
+  id.n = m.nGlobal;
+  id.nnz_loc = static_cast<MUMPS_INT8>(nnz);
+  id.irn_loc = m.irn.data();
+  id.jcn_loc = m.jcn.data();
+  id.a_loc = m.a.data();
+  switch (options_.ordering) {
+    case MumpsOptions::Ordering::Metis:
+      computeMetisOrdering();
+      ICNTL(id, 7) = 1;
+      id.perm_in = m.permIn.data();
+      break;
+    case MumpsOptions::Ordering::Pord: ICNTL(id, 7) = 4; break;
+    case MumpsOptions::Ordering::Amd: ICNTL(id, 7) = 0; break;
+    case MumpsOptions::Ordering::Amf: ICNTL(id, 7) = 2; break;
+    case MumpsOptions::Ordering::Qamd: ICNTL(id, 7) = 6; break;
+  }
+  call(1, "analysis");
+  analysed_ = true;
+  ++numAnalyses_;
+  analysisSeconds_ = MPI_Wtime() - t0;
+}
+
+// METIS_NodeND on the graph of A + A^T (no diagonal), on rank 0 from the
+// gathered pattern: what MUMPS' own sequential analysis would do with METIS.
+void MumpsSolver::computeMetisOrdering() {
+  Impl& m = *impl_;
+  const long long nnzLocal = static_cast<long long>(m.irn.size());
+  std::vector<long long> nnzAll(m.size);
+  MPI_Gather(&nnzLocal, 1, MPI_LONG_LONG, nnzAll.data(), 1, MPI_LONG_LONG, 0, m.comm);
+  long long nnzTotal = 0;
+  for (long long c : nnzAll) nnzTotal += c;
+  MPI_Bcast(&nnzTotal, 1, MPI_LONG_LONG, 0, m.comm);
+  if (nnzTotal > std::numeric_limits<int>::max() / 2)
+    throw std::invalid_argument("MumpsSolver: too many entries for the METIS ordering; use Pord");
+  std::vector<int> counts(m.size), displs(m.size);
+  for (int p = 0; p < m.size; ++p) {
+    counts[p] = static_cast<int>(nnzAll[p]);
+    displs[p] = p == 0 ? 0 : displs[p - 1] + counts[p - 1];
+  }
+  static_assert(sizeof(MUMPS_INT) == sizeof(int), "32-bit MUMPS_INT");
+  std::vector<int> I(m.rank == 0 ? nnzTotal : 0), J(m.rank == 0 ? nnzTotal : 0);
+  const int sendCount = static_cast<int>(nnzLocal);  // counts[] and displs[]: rank 0's only
+  MPI_Gatherv(m.irn.data(), sendCount, MPI_INT, I.data(), counts.data(), displs.data(), MPI_INT, 0, m.comm);
+  MPI_Gatherv(m.jcn.data(), sendCount, MPI_INT, J.data(), counts.data(), displs.data(), MPI_INT, 0, m.comm);
+  int ok = 1;
+  if (m.rank == 0) {
+    const int n = m.nGlobal;
+    std::vector<idx_t> xadj(n + 1, 0), adj;
+    for (long long k = 0; k < nnzTotal; ++k)
+      if (I[k] != J[k]) ++xadj[I[k]], ++xadj[J[k]];
+    for (int i = 0; i < n; ++i) xadj[i + 1] += xadj[i];
+    adj.resize(xadj[n]);
+    std::vector<idx_t> fill(xadj.begin(), xadj.end() - 1);
+    for (long long k = 0; k < nnzTotal; ++k)
+      if (I[k] != J[k]) adj[fill[I[k] - 1]++] = J[k] - 1, adj[fill[J[k] - 1]++] = I[k] - 1;
+    // Sort and drop duplicates (an entry and its transpose), compacting in place.
+    idx_t out = 0;
+    for (int i = 0; i < n; ++i) {
+      const idx_t b = xadj[i], e = xadj[i + 1];
+      std::sort(adj.begin() + b, adj.begin() + e);
+      xadj[i] = out;
+      for (idx_t k = b; k < e; ++k)
+        if (k == b || adj[k] != adj[k - 1]) adj[out++] = adj[k];
+    }
+    xadj[n] = out;
+    idx_t nv = n, options[METIS_NOPTIONS];
+    METIS_SetDefaultOptions(options);
+    options[METIS_OPTION_NUMBERING] = 0;
+    std::vector<idx_t> perm(n), iperm(n);
+    ok = METIS_NodeND(&nv, xadj.data(), adj.data(), nullptr, options, perm.data(), iperm.data()) == METIS_OK;
+    // METIS: row i of the permuted matrix is row perm[i] of A, so iperm[i] is
+    // variable i's place in the pivot order, MUMPS' PERM_IN(i) - 1.
+    m.permIn.resize(n);
+    for (int i = 0; i < n; ++i) m.permIn[i] = static_cast<MUMPS_INT>(iperm[i]) + 1;
+  }
+  MPI_Bcast(&ok, 1, MPI_INT, 0, m.comm);
+  if (!ok) throw std::runtime_error("MumpsSolver: METIS_NodeND failed");
+}
+
+void MumpsSolver::runFactorization() {
+  Impl& m = *impl_;
+  DMUMPS_STRUC_C& id = m.id;
+  const double t0 = MPI_Wtime();
+  id.a_loc = m.a.data();
+  id.job = 2;
+  dmumps_c(&id);
+  if (INFOG(id, 1) == -8 || INFOG(id, 1) == -9) {
+    // The analysis' estimate was short (delayed pivots): more room, once.
+    ICNTL(id, 14) = std::max(2 * ICNTL(id, 14), ICNTL(id, 14) + 50);
+    ++numWorkspaceRetries_;
+    id.job = 2;
+    dmumps_c(&id);
+  }
+  factorSeconds_ = MPI_Wtime() - t0;
+  call(0, "factorisation");  // checks the result
+  factored_ = true;
+  ++numFactorizations_;
+}
+
+// Runs JOB = job (0: only checks the last call's result) and throws on error.
+void MumpsSolver::call(int job, const char* phase) {
+  DMUMPS_STRUC_C& id = impl_->id;
+  if (job != 0) {
+    id.job = job;
+    dmumps_c(&id);
+  }
+  const int e = INFOG(id, 1);
+  if (e < 0)
+    throw std::runtime_error(std::string("MUMPS ") + phase + " failed: INFOG(1) = " + std::to_string(e) +
+                             ", INFOG(2) = " + std::to_string(INFOG(id, 2)) + explainInfog1(e));
+}
+
+void MumpsSolver::solve(const MultiVector& b, MultiVector& x) {
+  if (!impl_ || !factored_) throw std::logic_error("MumpsSolver::solve: no factorisation");
+  Impl& m = *impl_;
+  const double t0 = MPI_Wtime();
+  const std::size_t nrhs = b.getNumVectors();
+  const bool bad = x.getNumVectors() != nrhs || b.getLocalLength() != std::size_t(m.nLocal) ||
+                   x.getLocalLength() != std::size_t(m.nLocal);
+  if (anyRank(bad, m.comm) || !b.getMap()->isSameAs(*m.rowMap) || !x.getMap()->isSameAs(*m.rowMap))
+    throw std::invalid_argument("MumpsSolver::solve: b and x must be on the matrix' row map, alike in columns");
+  if (nrhs == 0) return;
+
+  const std::size_t n = m.nGlobal;
+  if (m.rank == 0) m.rhs.assign(n * nrhs, 0.0);
+  for (std::size_t j = 0; j < nrhs; ++j) {
+    const auto bj = b.getData(j);
+    MPI_Gatherv(bj.getRawPtr(), m.nLocal, MPI_DOUBLE, m.rank == 0 ? m.rhs.data() + j * n : nullptr,
+                m.counts.data(), m.offsets.data(), MPI_DOUBLE, 0, m.comm);
+  }
+  DMUMPS_STRUC_C& id = m.id;
+  id.nrhs = static_cast<MUMPS_INT>(nrhs);
+  id.lrhs = m.nGlobal;
+  id.rhs = m.rank == 0 ? m.rhs.data() : nullptr;
+  call(3, "solve");
+  for (std::size_t j = 0; j < nrhs; ++j) {
+    auto xj = x.getDataNonConst(j);
+    MPI_Scatterv(m.rank == 0 ? m.rhs.data() + j * n : nullptr, m.counts.data(), m.offsets.data(), MPI_DOUBLE,
+                 xj.getRawPtr(), m.nLocal, MPI_DOUBLE, 0, m.comm);
+  }
+  solveSeconds_ = MPI_Wtime() - t0;
+}
+
+std::int64_t MumpsSolver::factorEntries() const {
+  if (!impl_) return 0;
+  const std::int64_t v = INFOG(impl_->id, 29);
+  return v < 0 ? -v * 1000000 : v;  // negative: millions of entries
+}
+
+int MumpsSolver::peakMemoryMB() const { return impl_ ? INFOG(impl_->id, 21) : 0; }
+int MumpsSolver::totalMemoryMB() const { return impl_ ? INFOG(impl_->id, 22) : 0; }
+int MumpsSolver::orderingUsed() const { return impl_ ? INFOG(impl_->id, 7) : -1; }
+
+}  // namespace capstan

@@ -1,0 +1,111 @@
+// A distributed sparse direct solver (MUMPS 5.5, Debian's MPI build) for
+// capstan's Tpetra matrices. Why: the iterative solvers' iterations grow with the
+// mesh and with friction's non-symmetry; an exact LU of the Newton tangent is the
+// robust fallback, and Newton's tangents keep one sparsity pattern from iteration
+// to iteration, so the costly symbolic analysis is done once and only the numeric
+// factorisation is repeated.
+//
+// Each rank hands MUMPS its own rows (distributed assembled input, ICNTL(18) = 3,
+// 1-based global indices); right-hand sides are gathered to rank 0 (MUMPS' host)
+// and the solution is scattered back. Unsymmetric mode (SYM = 0).
+//
+// Every method is collective over the matrix's communicator, the destructor too
+// (MUMPS' JOB = -2): create and destroy a solver on every rank, before MPI is
+// finalised. Errors are thrown on every rank alike (std::runtime_error naming
+// the phase and MUMPS' INFOG(1), INFOG(2)), so a caller may catch and go on.
+#pragma once
+
+#include <Tpetra_CrsMatrix.hpp>
+#include <Tpetra_MultiVector.hpp>
+
+#include <cstdint>
+#include <memory>
+#include <type_traits>
+#include <vector>
+
+#include "types.hpp"
+
+namespace capstan {
+
+struct MumpsOptions {
+  // Fill-reducing ordering of the (sequential) analysis. Debian's libmumps has
+  // neither METIS nor SCOTCH compiled in (ICNTL(7) = 5 silently falls back to
+  // AMF), so Metis computes METIS_NodeND's ordering here, on rank 0 from the
+  // gathered pattern of A + A^T, and hands it to MUMPS (ICNTL(7) = 1, PERM_IN).
+  // Measured on a 3D 27-point, 3-dof elasticity-like stencil, 52,728 unknowns,
+  // 1 rank, Debian's reference BLAS (test_mumps, MumpsTiming; factor entries,
+  // factorisation time): Metis 78 M, 34-36 s; Pord 91 M, 58-61 s; AMF 112 M,
+  // 113-120 s; AMD and QAMD 120 M, 103-155 s. The analysis takes 0.2-0.6 s
+  // with any of them (Metis' includes gathering the pattern and METIS_NodeND).
+  // The factorisation is BLAS-bound: with OpenBLAS (one thread) in place of the
+  // reference BLAS, Metis 3.8 s, Pord 5.4 s, AMF 7.8 s (2 ranks, Metis: 2.3 s).
+  enum class Ordering { Metis, Pord, Amd, Amf, Qamd };
+  Ordering ordering = Ordering::Metis;
+  // ICNTL(14): percentage by which the working space may grow over the
+  // analysis' estimate (delayed pivots); < 0 keeps MUMPS' default. On
+  // INFOG(1) = -8 or -9 it is raised and the factorisation retried once.
+  int workspaceIncreasePercent = -1;
+  // MUMPS' own printing (ICNTL(1..4)); silent by default.
+  bool verbose = false;
+};
+
+class MumpsSolver {
+ public:
+  using Scalar = Tpetra::CrsMatrix<>::scalar_type;
+  using CrsMatrix = Tpetra::CrsMatrix<>;
+  using MultiVector = Tpetra::MultiVector<>;
+  static_assert(std::is_same<Scalar, double>::value, "MumpsSolver wraps dmumps (double)");
+
+  explicit MumpsSolver(const MumpsOptions& options = MumpsOptions());
+  ~MumpsSolver();
+  MumpsSolver(const MumpsSolver&) = delete;
+  MumpsSolver& operator=(const MumpsSolver&) = delete;
+
+  // Factorises A (fill complete, square, row map = domain map = range map, one
+  // to one; any GIDs, contiguous or not). The first call, and any call whose
+  // global sparsity pattern differs from the last one's, runs MUMPS' analysis;
+  // otherwise the analysis is reused and only the numeric factorisation runs.
+  // A must live on the communicator of the first call.
+  void factor(const CrsMatrix& A);
+
+  // Solves A x = b for every column of b (b on A's range map, x on its domain
+  // map, as many columns as b). Throws std::logic_error if nothing is factored.
+  void solve(const MultiVector& b, MultiVector& x);
+
+  // Counters (since construction).
+  int numAnalyses() const { return numAnalyses_; }
+  int numFactorizations() const { return numFactorizations_; }
+  int numWorkspaceRetries() const { return numWorkspaceRetries_; }  // -8/-9 retries
+
+  // The last factorisation's size and memory: entries in the factors (INFOG(29),
+  // all ranks) and MB used during the factorisation (INFOG(21): the largest on
+  // any rank; INFOG(22): all ranks together).
+  std::int64_t factorEntries() const;
+  int peakMemoryMB() const;
+  int totalMemoryMB() const;
+  // The ordering MUMPS used (INFOG(7): 0 AMD, 1 given (Metis here), 2 AMF, 4 PORD, 6 QAMD).
+  int orderingUsed() const;
+
+  // Wall times of the last analysis (with the pattern gathering and METIS),
+  // factorisation and solve (with the gather and scatter), in seconds.
+  double analysisSeconds() const { return analysisSeconds_; }
+  double factorSeconds() const { return factorSeconds_; }
+  double solveSeconds() const { return solveSeconds_; }
+
+ private:
+  struct Impl;  // MUMPS' structure stays out of the header
+  void initialize(const Teuchos::Comm<int>& comm);
+  bool extractPattern(const CrsMatrix& A);  // true if this rank's pattern changed
+  void analyse(const CrsMatrix& A);
+  void computeMetisOrdering();
+  void runFactorization();
+  void call(int job, const char* phase);
+
+  MumpsOptions options_;
+  std::unique_ptr<Impl> impl_;
+  bool analysed_ = false, factored_ = false;
+  int numAnalyses_ = 0, numFactorizations_ = 0, numWorkspaceRetries_ = 0;
+  double analysisSeconds_ = 0, factorSeconds_ = 0, solveSeconds_ = 0;
+};
+
+}  // namespace capstan
