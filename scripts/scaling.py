@@ -58,10 +58,10 @@ for case, f in plan:
         s = summary(out, command(args.capstan, scene, out, cells, ranks, args.set, args.steps), tag, "scaling.py")
         steps = s["steps"]
         newton, linear, pstep = totals(s)
-        log = os.path.join(out, "run.log")  # a run made by hand with CAPSTAN_NEWTON_LOG=1
+        log = os.path.join(out, "log.jsonl")  # a run made by hand with --log newton
         if pstep is None and os.path.isfile(log):
             with open(log) as fh:
-                pstep = sum(int(line.split()[2]) for line in fh if line.strip().startswith("pressure step:"))
+                pstep = sum(e.get("iterations", 0) for e in map(json.loads, fh) if e.get("event") == "pressure_step")
         t = s["timing"]
         rows.append({
             "case": case, "factor": f, "cells": "x".join(map(str, cells)), "ranks": ranks,
