@@ -126,7 +126,7 @@ int main(int argc, char** argv) {
   scene.mesh.min = {0, 0, 0};
   scene.mesh.max = {1, 1, 1};
   scene.mesh.cells = {n, n, n};
-  scene.solver = validParameters().sublist("Solver");
+  scene.solver = SolverSettings::defaults();
   scene.supports = {{"base", "ymin", "Fixed", {true, true, true}, 0, {0, 0, 0}}};
   BoxGenerator gen(scene.mesh.min, scene.mesh.max, scene.mesh.cells);
   Mesh mesh = distributeMesh(gen, comm);

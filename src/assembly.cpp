@@ -19,9 +19,9 @@ Kokkos::View<int*>::HostMirror activeOnHost(const LocalSystem& L) {
 Assembly::Assembly(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
   // Effects the scene calls for, and nothing else.
   const double epsSolve =
-      std::max(scene.pressurePenalty, scene.solver.get<double>("Minimum Solve Penalty") / scene.c);
+      std::max(scene.pressurePenalty, scene.solver.minimumSolvePenalty / scene.c);
   auto bricks = std::make_unique<BrickEffect>(mesh, scene.c, epsSolve,
-                                              scene.solver.get<double>("Volume Tolerance"));
+                                              scene.solver.volumeTolerance);
   bricks_ = bricks.get();
   effects_.push_back(std::move(bricks));
   nodeDofs_ = int(3 * mesh.numOverlapNodes());

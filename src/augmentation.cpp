@@ -42,10 +42,10 @@ bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string
   // increment's residual is huge (volume error / eps), and a tolerance relative
   // to it would accept a poorly converged state.
   const double r0 = std::min(bare, m_.forceScale);
-  const double tol = std::max(sol.get<double>("Newton Relative Tolerance") * r0, m_.absTolerance);
-  int maxOuter = sol.get<int>("Max Pressure Iterations");
+  const double tol = std::max(sol.newtonRelativeTolerance * r0, m_.absTolerance);
+  int maxOuter = sol.maxPressureIterations;
   for (const auto* c : assembly.contacts()) maxOuter = std::max(maxOuter, c->maxAugmentations());
-  AndersonMixing mixing(sol.get<int>("Pressure Acceleration Depth"), m_.comm);
+  AndersonMixing mixing(sol.pressureAccelerationDepth, m_.comm);
   Vector f(m_.u->getMap());
   for (int it = 1; it <= maxOuter; ++it) {
     // Later passes: down to round-off, 1e-3 x the absolute tolerance.
@@ -144,7 +144,7 @@ bool AugmentationLoop::saddlePointPressureStep(double t, Vector& f, StepRecord& 
   const auto stepStart = Clock::now();
   try {
     step = m_.pressureStep->solve(*W, m_.newton->approximateInverse(), f, kPressureStepTolerance, volumeTarget,
-                                  m_.scene.solver.get<int>("Max Linear Iterations"), dx, pressureStepDmu_);
+                                  m_.scene.solver.maxLinearIterations, dx, pressureStepDmu_);
   } catch (const std::exception&) {  // e.g. a preconditioner that cannot be built: a plain pass
     return false;
   }

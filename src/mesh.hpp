@@ -41,7 +41,7 @@ class MeshGenerator {
 //   it (a box's z, an annulus's axis). Each rank's nodes are then a run of
 //   the one-rank numbering, and MueLu's aggregation, which walks the nodes in
 //   that order, makes nearly the aggregates it makes on one rank
-//   (docs/performance.md, "Page faults and partitions").
+//   (docs/performance.md, "Partitions").
 enum class Partition { Metis, Slabs };
 
 // Mesh/Partition = Auto: Slabs on several ranks where each rank's slab is at

@@ -31,9 +31,10 @@ Model::Model(const Scene& scene_, const RCP<const Comm>& comm_)
   } catch (const InputError& e) {  // the Solver/NOX or Solver/Stratimikos sublist
     throw InputError(scene.file + ": " + e.what());
   }
-  if (scene.solver.get<std::string>("Pressure Update") == "Saddle Point") {
-    const std::string schur = scene.solver.get<std::string>("Pressure Step Schur");
-    const bool laplacian = schur == "Laplacian" || (schur == "Auto" && newton->iterative());
+  using S = SolverSettings;
+  if (scene.solver.pressureUpdate == S::PressureUpdate::SaddlePoint) {
+    const auto schur = scene.solver.pressureStepSchur;
+    const bool laplacian = schur == S::Schur::Laplacian || (schur == S::Schur::Auto && newton->iterative());
     pressureStep = std::make_unique<PressureStep>(
         *assembly, laplacian ? PressureStep::Schur::Laplacian : PressureStep::Schur::Diagonal);
   }
@@ -42,7 +43,7 @@ Model::Model(const Scene& scene_, const RCP<const Comm>& comm_)
   double size2 = 0;
   for (int d = 0; d < 3; ++d) size2 = std::max(size2, std::pow(m.max[d] - m.min[d], 2));
   forceScale = scene.c * size2;
-  absTolerance = scene.solver.get<double>("Newton Absolute Tolerance");
+  absTolerance = scene.solver.newtonAbsoluteTolerance;
   if (absTolerance == 0) absTolerance = 1e-13 * forceScale;
   long localFaces = long(assembly->contactFaceNodes().size() / 4);
   Teuchos::reduceAll(*comm, Teuchos::REDUCE_SUM, localFaces, Teuchos::outArg(numContactFaces));

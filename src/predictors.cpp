@@ -24,7 +24,7 @@ double Predictors::firstGuess(double t0, double t, StepRecord& rec) {
   // core's rotation has almost no stiffness: turn the body with the core first.
   bool rolled = !extrapolated && rollWithCores(t0, t);
   // A step that barely changes anything (steady rolling) needs no predictor.
-  if (!extrapolated && !rolled && m_.scene.solver.get<std::string>("Predictor") == "Tangent" &&
+  if (!extrapolated && !rolled && m_.scene.solver.predictor == SolverSettings::Predictor::Tangent &&
       bare > 1e-8 * m_.forceScale)
     tangent(t0, t, bare, rec);
   assembly.applyConstraints(*m_.u, t);
@@ -102,7 +102,7 @@ void Predictors::tangent(double t0, double t1, double bare, StepRecord& rec) {
   // A first guess: 1e-6 is plenty (Newton corrects it); a tighter tolerance
   // on a nearly steady step, where the right-hand side is at round-off, ran
   // GMRES to its limit.
-  const int its = m_.newton->linearSolve(rhs, du, std::max(1e-6, m_.scene.solver.get<double>("Linear Tolerance")));
+  const int its = m_.newton->linearSolve(rhs, du, std::max(1e-6, m_.scene.solver.linearTolerance));
   for (const auto& e : assembly.effects()) e->setPredicting(false);
   if (its < 0) return;  // keep the plain guess
   rec.linear += its;

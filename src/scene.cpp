@@ -20,6 +20,7 @@
 #include <sstream>
 
 #include "errors.hpp"
+#include "parameters.hpp"
 
 namespace capstan {
 
@@ -155,55 +156,7 @@ ParameterList validParameters() {
   time.set("Steps", 1, "Number of steps (>= 1)");
   time.set("Step Size", 1.0, "dt > 0");
 
-  auto& sol = p.sublist("Solver", false, "Nonlinear and linear solvers");
-  sol.set("Linear Solver", std::string("Auto"),
-          "Auto | GMRES | CG | Direct (Belos GMRES, Belos CG, Amesos2 KLU2). Auto: Direct up to "
-          "Direct Solver Max Dofs on one rank, GMRES otherwise");
-  sol.set("Direct Solver Max Dofs", 5000, "Auto: largest problem solved directly");
-  sol.set("Preconditioner", std::string("Auto"),
-          "Auto | ILU | Jacobi | MueLu | None (Ifpack2 RILUK per rank, Jacobi relaxation; MueLu smoothed "
-          "aggregation with the rigid-body modes). Auto: MueLu from 1000 dofs, ILU below");
-  sol.set("ILU Level", 1, "ILU: level of fill (>= 0)");
-  sol.set("Preconditioner Reuse", std::string("Adaptive"),
-          "Adaptive | None. Adaptive: Newton builds its preconditioner at each load step's start "
-          "and keeps it across iterations and pressure passes, rebuilding it when a Krylov solve "
-          "needs more than twice the iterations (+10) of the first solve after the last build, or "
-          "hits its limit; None: a new one every Newton iteration");
-  sol.set("Linear Tolerance", 1e-10, "Relative residual of each linear solve (0 < tol < 1)");
-  sol.set("Linear Tolerance Method", std::string("Adaptive"),
-          "Adaptive | Fixed. Adaptive: Eisenstat-Walker forcing terms (each Krylov solve only as "
-          "tight as Newton's progress needs, never tighter than Linear Tolerance); Fixed: every "
-          "Krylov solve to Linear Tolerance. Direct solves are exact either way");
-  sol.set("Max Linear Iterations", 2000, "Krylov iteration limit per linear solve");
-  sol.set("Newton Relative Tolerance", 1e-10, "Converged when |R| <= this x |R| at the step's start");
-  sol.set("Newton Absolute Tolerance", 0.0, "Converged when |R| <= this; 0 = 1e-13 x c x (body size)^2");
-  sol.set("Max Newton Iterations", 30, "Newton iteration limit per solve");
-  sol.set("Predictor", std::string("Tangent"),
-          "Tangent (linear response to the step's prescribed increment, from the previous "
-          "step) | Previous (the previous step's solution with the new boundary values)");
-  sol.set("Line Search", std::string("Backtrack"), "Backtrack | Polynomial | Full Step (NOX line search)");
-  sol.set("Volume Tolerance", 1e-10, "Pressure loop ends when max |v_e/V_e - 1| is below this");
-  sol.set("Max Pressure Iterations", 100, "Most pressure-anchor updates per step");
-  sol.set("Pressure Update", std::string("Auto"),
-          "How the pressure loop moves the element pressure anchors after each Newton solve: "
-          "Saddle Point (positions, anchors and exact contact's multipliers from one block Krylov solve, "
-          "v_e = V_e and g = 0 to first order), "
-          "Anderson (pbar <- p(x), Anderson-accelerated), or Auto (Saddle Point without friction, "
-          "Anderson with it)");
-  sol.set("Pressure Step Schur", std::string("Auto"),
-          "The saddle-point step's approximation of its volume rows' Schur complement: Laplacian "
-          "((eps V)^-1 + 0.15 L^-1, L = G^T diag(K0)^-1 G by 30 CG iterations: it holds Q1P0's nearly "
-          "spurious pressure modes), Diagonal ((eps V)^-1 alone), or Auto (Laplacian with Krylov "
-          "linear solves, Diagonal with a direct solver, whose exact K^-1 leaves it little to gain). "
-          "The same answer either way");
-  sol.set("Pressure Acceleration Depth", 5,
-          "Anderson acceleration depth of the pressure loop (0 = plain pbar <- p(x))");
-  sol.set("Minimum Solve Penalty", -1.0,
-          "Smallest eps1 x c used in the Newton solves: below it the condensed pressure "
-          "cannot be evaluated in double precision; the pressure loop still makes v_e = V_e exact. "
-          "-1: automatic, 3e-2 with the Saddle Point pressure update, 1e-2 with Anderson");
-  sol.sublist("NOX", false, "Passed to NOX unchanged, over capstan's defaults");
-  sol.sublist("Stratimikos", false, "Passed to Stratimikos unchanged, over capstan's defaults");
+  SolverSettings::declare(p.sublist("Solver", false, "Nonlinear and linear solvers"));
 
   auto& out = p.sublist("Output", false, "Where and what to write");
   out.set("Directory", std::string("out"), "Output directory (created if missing)");
@@ -301,14 +254,6 @@ struct Validator {
 std::string trimmed(const std::string& s) {
   const auto a = s.find_first_not_of(" \t\r\n"), b = s.find_last_not_of(" \t\r\n");
   return a == std::string::npos ? "" : s.substr(a, b - a + 1);
-}
-
-// 0.01, not 1.00000000000000002e-02: 6 digits where they read back the same, else 17.
-std::string shortest(double x) {
-  std::ostringstream brief, full;
-  brief << x;
-  full << std::setprecision(17) << x;
-  return std::strtod(brief.str().c_str(), nullptr) == x ? brief.str() : full.str();
 }
 
 std::string brief(double x) {  // 6 digits, for descriptions
@@ -981,52 +926,13 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
   for (auto& s : sc.supports)
     if (s.type == "Rigid Core" && s.rampTime == 0) s.rampTime = sc.stepSize;
 
-  sc.solver = P.sublist("Solver");
-  const auto& sol = sc.solver;
-  auto oneOf = [&](const std::string& name, const std::set<std::string>& allowed) {
-    v.oneOf(sol, "Solver", name, allowed);
-  };
-  oneOf("Linear Solver", {"Auto", "GMRES", "CG", "Direct"});
+  const bool friction = std::any_of(sc.capstans.begin(), sc.capstans.end(),
+                                    [](const CapstanSpec& c) { return c.frictionLaw != "None"; });
+  sc.solver = SolverSettings::parse(P.sublist("Solver"), ParameterReader{file}, friction);
   for (const auto& c : sc.capstans)
-    if (c.frictionLaw != "None" && sol.get<std::string>("Linear Solver") == "CG")
+    if (c.frictionLaw != "None" && sc.solver.linearSolver == SolverSettings::LinearSolver::CG)
       v.fail("Solver/Linear Solver", "CG needs a symmetric matrix; friction on capstan '" + c.name +
                                          "' makes it non-symmetric (use Auto, GMRES or Direct)");
-  oneOf("Preconditioner", {"Auto", "ILU", "Jacobi", "MueLu", "None"});
-  oneOf("Line Search", {"Backtrack", "Polynomial", "Full Step"});
-  oneOf("Predictor", {"Tangent", "Previous"});
-  oneOf("Linear Tolerance Method", {"Adaptive", "Fixed"});
-  oneOf("Preconditioner Reuse", {"Adaptive", "None"});
-  oneOf("Pressure Update", {"Auto", "Saddle Point", "Anderson"});
-  oneOf("Pressure Step Schur", {"Auto", "Laplacian", "Diagonal"});
-  for (const char* n : {"Linear Tolerance", "Newton Relative Tolerance", "Volume Tolerance"}) {
-    const double x = sol.get<double>(n);
-    if (!(x > 0 && x < 1)) v.fail(std::string("Solver/") + n, "must be in (0, 1)");
-  }
-  if (!(sol.get<double>("Newton Absolute Tolerance") >= 0)) v.fail("Solver/Newton Absolute Tolerance", "must be >= 0");
-  {
-    const double x = sol.get<double>("Minimum Solve Penalty");
-    if (!(x > 0 || x == -1) || !std::isfinite(x))
-      v.fail("Solver/Minimum Solve Penalty", "must be > 0, or -1 (automatic), got " + Teuchos::toString(x));
-  }
-  // The automatic choices, resolved here so that the run (and its summary)
-  // sees what is used. Pressure Update: the saddle-point step without
-  // friction; with friction the Anderson loop, whose extra passes converge the
-  // path-dependent friction multipliers further than their tolerance (the
-  // saddle-point step met the tolerances but moved H4's finely stepped force
-  // by 1.3e-4 and 1 vs 2 ranks on the pinch roller by 1.5e-7; not measured
-  // faster there). Minimum Solve Penalty: the fastest on G1 for each update
-  // (docs/performance.md): 3e-2 with the saddle-point step, 1e-2 with Anderson.
-  if (sol.get<std::string>("Pressure Update") == "Auto") {
-    const bool friction = std::any_of(sc.capstans.begin(), sc.capstans.end(),
-                                      [](const CapstanSpec& c) { return c.frictionLaw != "None"; });
-    sc.solver.set("Pressure Update", std::string(friction ? "Anderson" : "Saddle Point"));
-  }
-  if (sol.get<double>("Minimum Solve Penalty") == -1)
-    sc.solver.set("Minimum Solve Penalty", sol.get<std::string>("Pressure Update") == "Saddle Point" ? 3e-2 : 1e-2);
-  for (const char* n : {"Max Linear Iterations", "Max Newton Iterations", "Max Pressure Iterations"})
-    if (sol.get<int>(n) < 1) v.fail(std::string("Solver/") + n, "must be >= 1");
-  if (sol.get<int>("ILU Level") < 0) v.fail("Solver/ILU Level", "must be >= 0");
-  if (sol.get<int>("Pressure Acceleration Depth") < 0) v.fail("Solver/Pressure Acceleration Depth", "must be >= 0");
 
   const auto& out = P.sublist("Output");
   sc.outputDirectory = out.get<std::string>("Directory");

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "solver_settings.hpp"
+
 namespace capstan {
 
 struct MeshSpec {
@@ -64,7 +66,7 @@ struct Scene {
   std::vector<CapstanSpec> capstans;
   int steps = 1;
   double stepSize = 1;
-  Teuchos::ParameterList solver;   // the resolved Solver sublist
+  SolverSettings solver;           // the Solver sublist, typed and resolved
   std::string outputDirectory;
   bool writeFields = true;
   int checkpointEvery = 0;         // Output/Checkpoint Every: steps between checkpoints, 0 = none

@@ -26,7 +26,7 @@ Scene boxScene() {
   s.mesh.cells = {4, 2, 3};
   s.c = 1.3;
   s.pressurePenalty = 1e-2;
-  s.solver = validParameters().sublist("Solver");
+  s.solver = SolverSettings::defaults();
   SupportSpec fixed{"base", "ymin", "Fixed", {true, true, true}, 0, {0, 0, 0}};
   SupportSpec roll{"side", "xmin", "Roller", {true, false, false}, 0, {0, 0, 0}};
   SupportSpec spring{"spring", "zmax", "Foundation", {false, true, true}, 0.7, {0, 0, 0}};
@@ -334,9 +334,9 @@ TEST(PressureStep, PredictsTheVolumeErrorAfterNewton) {
 TEST(PressureStep, SchurModelsGiveTheSameStep) {
   Scene fine = boxScene();
   fine.mesh.cells = {16, 8, 12};
-  fine.solver.set("Linear Solver", std::string("GMRES"));
-  fine.solver.set("Preconditioner", std::string("MueLu"));
-  fine.solver.set("Minimum Solve Penalty", 3e-2);  // as Auto sets it for the saddle-point step
+  fine.solver.linearSolver = SolverSettings::LinearSolver::GMRES;
+  fine.solver.preconditioner = SolverSettings::Preconditioner::MueLu;
+  fine.solver.minimumSolvePenalty = 3e-2;  // as Auto sets it for the saddle-point step
   BoxProblem problem(fine, 0.2);
   auto& [scene, mesh, assembly, newton, u, f] = problem;
   auto W = newton.matrix();

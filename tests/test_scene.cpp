@@ -467,13 +467,13 @@ TEST_F(SceneTest, AccuracyPresets) {
   const std::array<int, 3> cells = loadScene(file, {}, "").mesh.cells;
   const Scene scene = loadScene(file, {"Accuracy=Scene"}, "");
   EXPECT_EQ(scene.mesh.cells, cells);
-  EXPECT_EQ(scene.solver.get<double>("Newton Relative Tolerance"), 1e-10);
+  EXPECT_EQ(scene.solver.newtonRelativeTolerance, 1e-10);
   const Scene draft = loadScene(file, {"Accuracy=Draft"}, "");
   EXPECT_EQ(draft.mesh.cells, cells);
-  EXPECT_EQ(draft.solver.get<double>("Newton Relative Tolerance"), 1e-6);
+  EXPECT_EQ(draft.solver.newtonRelativeTolerance, 1e-6);
   // A tolerance the scene sets itself wins over the preset.
   const Scene draftOwn = loadScene(file, {"Accuracy=Draft", "Solver/Newton Relative Tolerance=1e-9"}, "");
-  EXPECT_EQ(draftOwn.solver.get<double>("Newton Relative Tolerance"), 1e-9);
+  EXPECT_EQ(draftOwn.solver.newtonRelativeTolerance, 1e-9);
   const Scene standard = loadScene(file, {"Accuracy=Standard"}, "");
   const Scene fine = loadScene(file, {"Accuracy=Fine"}, "");
   for (int d = 0; d < 3; ++d) {
@@ -507,8 +507,8 @@ TEST_F(SceneTest, SetReachesNamedObjectsAndAbsentSublists) {
   ASSERT_EQ(s.supports.size(), 3u);
   EXPECT_EQ(s.supports[1].velocity, (std::array<double, 3>{-0.5, 0, 0.25}));
   EXPECT_EQ(s.steps, 7);
-  EXPECT_EQ(s.solver.get<std::string>("Line Search"), "Full Step");
-  EXPECT_EQ(s.solver.get<int>("Max Newton Iterations"), 3);
+  EXPECT_EQ(s.solver.lineSearch, SolverSettings::LineSearch::FullStep);
+  EXPECT_EQ(s.solver.maxNewtonIterations, 3);
   EXPECT_EQ(s.title, "changed");
   EXPECT_EQ(s.pressurePenalty, 1e-13);
   // A parameter the scene file does not give (its sublist absent too): typed from the valid list.
@@ -517,7 +517,7 @@ TEST_F(SceneTest, SetReachesNamedObjectsAndAbsentSublists) {
 </ParameterList>
 )X");
   const Scene b = loadScene(bare, {"Solver/Linear Solver=Direct", "Time/Step Size=0.5"}, "");
-  EXPECT_EQ(b.solver.get<std::string>("Linear Solver"), "Direct");
+  EXPECT_EQ(b.solver.linearSolver, SolverSettings::LinearSolver::Direct);
   EXPECT_EQ(b.stepSize, 0.5);
 }
 
