@@ -48,4 +48,10 @@ std::string shortest(double x) {
   return std::strtod(brief.str().c_str(), nullptr) == x ? brief.str() : full.str();
 }
 
+std::string brief(double x) {
+  std::ostringstream out;
+  out << x;
+  return out.str();
+}
+
 }  // namespace capstan

@@ -47,5 +47,7 @@ const char* nameOf(E e, const std::vector<std::pair<const char*, E>>& choices) {
 
 // 0.01, not 1.00000000000000002e-02: 6 digits where they read back the same, else 17.
 std::string shortest(double x);
+// 6 digits, for descriptions in messages.
+std::string brief(double x);
 
 }  // namespace capstan

@@ -3,12 +3,12 @@
 #include <Teuchos_CommHelpers.hpp>
 
 #include <chrono>
-#include <charconv>
 #include <fstream>
 #include <map>
 
 #include "collective.hpp"
 #include "errors.hpp"
+#include "parameters.hpp"
 
 namespace capstan {
 
@@ -159,10 +159,6 @@ Restart::Restart(const Scene& scene, const Comm& comm, const std::string& dir)
     const double dt = rd.get<double>();
     const auto min = rd.get<std::array<double, 3>>(), max = rd.get<std::array<double, 3>>();
     const auto cells = rd.get<std::array<int, 3>>();
-    auto shortest = [](double x) {  // 0.01, not 1.00000000000000002e-02
-      char buf[32];
-      return std::string(buf, std::to_chars(buf, buf + sizeof buf, x).ptr);
-    };
     auto text = [&](const auto& a) {
       return "{" + shortest(a[0]) + ", " + shortest(a[1]) + ", " + shortest(a[2]) + "}";
     };

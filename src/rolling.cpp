@@ -1,9 +1,9 @@
 #include "rolling.hpp"
 
 #include <cmath>
-#include <sstream>
 
 #include "assembly.hpp"
+#include "parameters.hpp"
 #include "vec3.hpp"
 
 namespace capstan {
@@ -19,11 +19,6 @@ double noSlipAngularVelocity(const Scene& scene, const RigidCore& core) {
 }
 
 std::string brakeDiagnosis(const Scene& scene) {
-  auto brief = [](double x) {
-    std::ostringstream o;
-    o << x;
-    return o.str();
-  };
   std::string out;
   if (scene.mesh.type != "Annulus") return out;
   for (const auto& s : scene.supports) {

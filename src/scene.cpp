@@ -21,6 +21,7 @@
 
 #include "errors.hpp"
 #include "parameters.hpp"
+#include "vec3.hpp"
 
 namespace capstan {
 
@@ -256,11 +257,6 @@ std::string trimmed(const std::string& s) {
   return a == std::string::npos ? "" : s.substr(a, b - a + 1);
 }
 
-std::string brief(double x) {  // 6 digits, for descriptions
-  std::ostringstream out;
-  out << x;
-  return out.str();
-}
 
 // A finite double written in decimal (no hex, inf or nan), or false.
 bool readDouble(const std::string& text, double& x) {
@@ -462,9 +458,7 @@ void warnUnreachable(Scene& sc, const CapstanSpec& c) {
   }
   const double grow = size + travel;
   for (int i = 0; i < 3; ++i) lo[i] -= grow, hi[i] += grow;
-  std::array<double, 3> b = c.axisDirection;
-  const double nb = std::sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
-  for (double& x : b) x /= nb;
+  const Vec3 b = unit(c.axisDirection);
   auto pointToBox = [&](const std::array<double, 3>& p) {
     double d2 = 0;
     for (int i = 0; i < 3; ++i) {
@@ -675,9 +669,7 @@ static void readRigidCore(const ParameterList& s, const std::string& path, const
   d = three<double>(s, "Axis Direction", v, path);
   const double m = std::max({std::fabs(d[0]), std::fabs(d[1]), std::fabs(d[2])});
   if (!(m > 0) || !std::isfinite(m)) v.fail(path + "/Axis Direction", "must be a finite non-zero vector");
-  for (double& x : d) x = std::ldexp(x, -std::ilogb(m));
-  const double n = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-  for (double& x : d) x /= n;
+  d = unit(scaledDirection(d));
   const std::string free = s.get<std::string>("Free Translation");
   if (free.find_first_not_of(" ,") != std::string::npos)
     spec.freeTranslation = components(free, v, path + "/Free Translation");
@@ -723,8 +715,7 @@ static void rejectSingularCores(const Scene& sc, const Validator& v) {
       bool held = false;
       for (const auto& c : sc.capstans) {
         const auto& b = c.axisDirection;
-        const double nb = std::sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
-        held |= std::fabs(b[i]) / nb < 1 - 1e-12;  // the capstan's normals have a component along i
+        held |= std::fabs(b[i]) / norm(b) < 1 - 1e-12;  // the capstan's normals have a component along i
       }
       if (!held)
         v.fail(path + "/Free Translation",
@@ -860,12 +851,10 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
     cs.axisPoint = three<double>(c, "Axis Point", v, path);
     cs.axisDirection = three<double>(c, "Axis Direction", v, path);
     {
-      // Scaled by a power of two (exact: a direction of ordinary size keeps
-      // its bits), so that 1e-200 or 1e200 do not under- or overflow |beta|^2.
       auto& b = cs.axisDirection;
       const double m = std::max({std::fabs(b[0]), std::fabs(b[1]), std::fabs(b[2])});
       if (!(m > 0)) v.fail(path + "/Axis Direction", "must be a non-zero vector, got {0, 0, 0}");
-      for (double& x : b) x = std::ldexp(x, -std::ilogb(m));
+      b = scaledDirection(b);
     }
     cs.velocity = three<double>(c, "Velocity", v, path);
     cs.angularVelocity = c.get<double>("Angular Velocity");
