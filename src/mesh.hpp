@@ -46,10 +46,8 @@ enum class Partition { Metis, Slabs };
 
 // Mesh/Partition = Auto: Slabs on several ranks where each rank's slab is at
 // least kAutoSlabLayers cells thick along the slowest index, METIS otherwise.
-// Measured on 2 ranks (docs/performance.md, "The 2-rank speed-up in rounds"):
-// G1 8x, 24 layers a slab, slabs took 282.8 s on the mean of seven rounds
-// against METIS's 328.9 s; H1 8x, 4 layers, slabs were slower (67.4 s against
-// 63.9 s); G1 4x, 12 layers, the same Krylov iterations (1,001 against 1,007).
+// Thick slabs keep MueLu's aggregates as on one rank; thin ones leave the
+// ranks unequal (docs/performance.md, "Defaults and why" and "Partitions").
 constexpr int kAutoSlabLayers = 16;
 Partition autoPartition(int slowestCells, int ranks);
 // Mesh/Partition's value: "METIS", "Slabs", or "Auto" (autoPartition), and back;

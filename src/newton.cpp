@@ -289,9 +289,8 @@ Teuchos::ParameterList stratimikosParameters(const SolverSettings& solver, long 
       st.set("Maximum Restarts", 20);
     }
     S::Preconditioner prec = solver.preconditioner;
-    // Auto: smoothed aggregation pays for its setup from about 1000 dofs on
-    // (G1, 1575 dofs: GMRES+MueLu 2.9 s, GMRES+ILU 6.5 s; 28x8x12, 10k dofs:
-    // 38 s vs 132 s); below, ILU is cheaper (H5, 378 dofs, 2 ranks: 1.5 s vs 3.5 s).
+    // Auto: smoothed aggregation pays for its setup from about 1000 dofs on;
+    // below, ILU is cheaper (docs/performance.md, "Defaults and why").
     if (prec == S::Preconditioner::Auto) prec = dofs >= 1000 ? S::Preconditioner::MueLu : S::Preconditioner::ILU;
     if (prec == S::Preconditioner::None) {
       p.set("Preconditioner Type", "None");
@@ -317,14 +316,13 @@ Teuchos::ParameterList stratimikosParameters(const SolverSettings& solver, long 
       }
       ml.set("coarse: max size", 1500);
       // Restriction applied as P^T instead of a stored R: the same iterations
-      // and time, 5% less memory (G1 4x: 654 against 690 MiB on 1 rank).
+      // and time, 5% less memory (docs/performance.md, "Defaults and why").
       ml.set("transpose: use implicit", true);
       ml.set("Nullspace", nullspace);
       // On several ranks the coarse levels (below 2000 unknowns per rank) move
       // onto one rank, so that the coarsest solve is a serial KLU2: Amesos2's
       // KLU2 on a distributed matrix solves wrongly in Trilinos 13.2, and a
-      // wrong coarse solve doubled MueLu's iterations (H1 4x without friction,
-      // 2 ranks: 450 Krylov iterations, 210 with this; 1 rank: 211).
+      // wrong coarse solve doubles MueLu's iterations (docs/performance.md).
       if (ranks > 1) {
         ml.set("repartition: enable", true);
         ml.set("repartition: partitioner", "zoltan2");
@@ -385,8 +383,8 @@ struct NewtonSolver::Impl {
     // kink). A failed line search takes no step (Recovery Step 0): NOX's
     // default takes the full Newton step anyway, into inverted states where the
     // tangent is singular (the direct solver throws), and at round-off, where no
-    // step decreases |R|, it wanders until Stagnation stops it (H5: 70 Newton
-    // iterations instead of 42, same answer; tests/integration/line_search.py).
+    // step decreases |R|, it wanders until Stagnation stops it
+    // (tests/integration/line_search.py measures both).
     if (solver.lineSearch == SolverSettings::LineSearch::Backtrack) {
       lsp.sublist("Backtrack").set("Max Iters", 20);
       lsp.sublist("Backtrack").set("Recovery Step", 0.0);
@@ -396,14 +394,13 @@ struct NewtonSolver::Impl {
     // Eisenstat-Walker (NOX's Type 2): far from the solution a Krylov solve to
     // 1e-10 is wasted work, since the next Newton step changes the system
     // anyway. Solving to eta_k ~ (|R_k|/|R_k-1|)^1.5 keeps Newton superlinear
-    // and cut G1's Krylov iterations 2.5x (docs/performance.md). The answer is
-    // the same: Newton still converges to its own tolerance.
+    // and cuts the Krylov iterations 2.5x (docs/performance.md, "Defaults and
+    // why"). The answer is the same: Newton still converges to its own tolerance.
     if (solver.linearToleranceMethod == SolverSettings::ToleranceMethod::Adaptive) {
       newton.set("Forcing Term Method", "Type 2");
       newton.set("Forcing Term Minimum Tolerance", solver.linearTolerance);
-      // Never looser than 1e-3: NOX's default ceiling let H1 on 2 ranks (soft
-      // foundation, block-Jacobi ILU) crawl at 30 Newton iterations per step;
-      // with 1e-2 or 1e-3 it takes 22-25, and G1 costs the same either way.
+      // Never looser than 1e-3: with NOX's default ceiling a soft foundation
+      // under block-Jacobi ILU (H1 on 2 ranks) crawled at the iteration limit.
       newton.set("Forcing Term Maximum Tolerance",
                  std::max(1e-3, solver.linearTolerance));
     }

@@ -92,9 +92,7 @@ SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterRe
   s.maxPressureIterations = r.atLeast(sol, at, "Max Pressure Iterations", 1);
   // Auto: the saddle-point step without friction; with friction the Anderson
   // loop, whose extra passes converge the path-dependent friction multipliers
-  // further than their tolerance (the saddle-point step met the tolerances
-  // but moved H4's finely stepped force by 1.3e-4, and 1 vs 2 ranks on the
-  // pinch roller by 1.5e-7; not measured faster there).
+  // further than their tolerance (docs/performance.md, "Defaults and why").
   enum class Update { Auto, SaddlePoint, Anderson };
   const Update update = r.choice(sol, at, "Pressure Update",
                                  std::vector<std::pair<const char*, Update>>{{"Auto", Update::Auto},
