@@ -18,7 +18,11 @@
 #include <vector>
 
 #include "../kernels/rigid_core.hpp"
-#include "effects.hpp"
+#include "effects/body_force.hpp"
+#include "effects/bricks.hpp"
+#include "effects/contact.hpp"
+#include "effects/foundation.hpp"
+#include "effects/friction.hpp"
 #include "mesh.hpp"
 #include "scene.hpp"
 
@@ -184,7 +188,7 @@ class Assembly {
   Constraints constraints_;
   RCP<FEGraph> graph_;
   std::vector<std::vector<LO>> columns_;  // per effect: [entity * dofs + k] matrix column ids
-  // Per effect: where its kernel puts each entity's tangent (effects.hpp): the
+  // Per effect: where its kernel puts each entity's tangent (effects/effect.hpp): the
   // CRS offsets of its 3-column blocks and held columns, found once (4-byte
   // offsets, one per block: a sixth of the memory and traffic of one 8-byte
   // offset per entry; a rank's matrix holds fewer than 2^31 entries), and the
