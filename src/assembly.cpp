@@ -16,14 +16,7 @@ Kokkos::View<int*>::HostMirror activeOnHost(const LocalSystem& L) {
 }
 }  // namespace
 
-Assembly::Assembly(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
-  // Effects the scene calls for, and nothing else.
-  const double epsSolve =
-      std::max(scene.pressurePenalty, scene.solver.get<double>("Minimum Solve Penalty") / scene.c);
-  auto bricks = std::make_unique<BrickEffect>(mesh, scene.c, epsSolve,
-                                              scene.solver.get<double>("Volume Tolerance"));
-  bricks_ = bricks.get();
-  effects_.push_back(std::move(bricks));
+Assembly::Assembly(const Mesh& mesh, const Scene& scene) : mesh_(mesh), effects_(buildEffects(mesh, scene)) {
   nodeDofs_ = int(3 * mesh.numOverlapNodes());
   // Rigid cores first: their face nodes follow the core whatever other
   // support also names them.
@@ -44,13 +37,7 @@ Assembly::Assembly(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
   constraints_.supportOf.assign(ndof, -1);
   constraints_.velocity.assign(ndof, 0.0);
   for (const auto& s : scene.supports) {
-    if (s.type == "Foundation") {
-      auto f = std::make_unique<FoundationEffect>("foundation:" + s.name, mesh, s.face, s.stiffness,
-                                                  s.components);
-      foundations_.push_back(f.get());
-      effects_.push_back(std::move(f));
-      continue;
-    }
+    if (s.type == "Foundation") continue;  // an effect (src/effects/factory.hpp), no held dofs
     const int id = int(constraints_.supportNames.size());
     constraints_.supportNames.push_back(s.name);
     if (s.type == "Rigid Core") {
@@ -76,61 +63,6 @@ Assembly::Assembly(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
       }
   }
 
-  if (scene.bodyForce != std::array<double, 3>{0, 0, 0})
-    effects_.push_back(std::make_unique<BodyForceEffect>(mesh, scene.bodyForce, scene.steps * scene.stepSize));
-
-  for (const auto& c : scene.capstans) {
-    ContactEffect::Settings set;
-    set.radius = c.radius;
-    set.axisPoint = c.axisPoint;
-    set.axisDirection = c.axisDirection;
-    set.velocity = c.velocity;
-    set.penalty = c.penalty;
-    set.exact = c.method == "Augmented Lagrangian";
-    set.minimumSolvePenalty = c.minimumSolvePenalty;
-    set.c = scene.c;
-    set.tolerance = c.penetrationTolerance;
-    set.maxAugmentations = c.maxAugmentations;
-    set.rule = c.quadrature;
-    set.smoothing = c.smoothing;
-    // Candidate faces, each once even if two named faces share one. Every
-    // capstan's faces also get an index in the union of all candidate faces
-    // (the contact-face grid of fields.h5).
-    std::vector<int> quads;
-    std::set<std::array<int, 4>> mine;
-    contactFaceOf_.emplace_back();
-    for (const auto& name : c.contactFaces) {
-      const auto& q = mesh.faces.at(name);
-      for (size_t f = 0; f < q.size(); f += 4) {
-        std::array<int, 4> key{q[f], q[f + 1], q[f + 2], q[f + 3]};
-        std::sort(key.begin(), key.end());
-        if (!mine.insert(key).second) continue;
-        auto [it, fresh] = contactFaceIndex_.insert({key, int(contactFaceIndex_.size())});
-        if (fresh) contactFaceNodes_.insert(contactFaceNodes_.end(), q.begin() + f, q.begin() + f + 4);
-        quads.insert(quads.end(), q.begin() + f, q.begin() + f + 4);
-        contactFaceOf_.back().push_back(it->second);
-      }
-    }
-    auto effect = std::make_unique<ContactEffect>("contact:" + c.name, mesh, quads, set);
-    contacts_.push_back(effect.get());
-    frictions_.push_back(nullptr);
-    const ContactEffect& contact = *effect;
-    effects_.push_back(std::move(effect));
-    if (c.frictionLaw == "None") continue;  // no friction kernel at all
-    FrictionEffect::Settings fs;
-    fs.law = c.frictionLaw == "Tanh"     ? kernels::FrictionLaw::Tanh
-             : c.frictionLaw == "Arctan" ? kernels::FrictionLaw::Arctan
-                                         : kernels::FrictionLaw::Coulomb;
-    fs.mu = c.frictionCoefficient;
-    fs.regularization = c.regularization;
-    fs.tangentPenalty = c.tangentialPenalty;
-    fs.smoothing = c.frictionSmoothing;
-    fs.angularVelocity = c.angularVelocity;
-    auto friction = std::make_unique<FrictionEffect>("friction:" + c.name, mesh, quads, contact, fs);
-    frictions_.back() = friction.get();
-    effects_.push_back(std::move(friction));
-  }
-
   // Graph from every effect's entities: built once, fixed sparsity. An entity
   // with a core's face node also couples to the core's free unknowns.
   buildDofMaps();
@@ -149,7 +81,7 @@ Assembly::Assembly(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
     auto h = perRow.view_host();
     Kokkos::deep_copy(h, size_t(81 + 4 * cores_.size()));
     std::vector<std::vector<char>> seen(cores_.size(), std::vector<char>(constraints_.supportOf.size(), 0));
-    for (const auto& effect : effects_) {
+    for (const auto& effect : effects_.all) {
       if (!effect->local().stiff) continue;
       auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), effect->local().dofs);
       for (size_t e = 0; e < dofs.extent(0); ++e)
@@ -168,7 +100,7 @@ Assembly::Assembly(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
     graph_ = rcp(new FEGraph(ownedDofMap_, overlapDofMap_, perRow, importer_));
   }
   graph_->beginAssembly();
-  for (const auto& effect : effects_) {
+  for (const auto& effect : effects_.all) {
     coupled_.emplace_back();
     if (!effect->local().stiff) continue;  // no stiffness, no graph entries
     auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), effect->local().dofs);
@@ -198,7 +130,7 @@ Assembly::Assembly(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
   const auto& colMap = *graph_->getColMap();
   columnOf_.resize(constraints_.supportOf.size());
   for (size_t d = 0; d < columnOf_.size(); ++d) columnOf_[d] = colMap.getLocalElement(gid(int(d)));
-  for (const auto& effect : effects_) {
+  for (const auto& effect : effects_.all) {
     if (!effect->local().stiff) {
       columns_.emplace_back();
       continue;
@@ -233,8 +165,8 @@ void Assembly::assembleCoreCoupling(FEMatrix& W) {
   auto& touched = coupling_.touched;
   toCore.assign(nq * nodeDofs_, 0.0), fromCore.assign(nq * nodeDofs_, 0.0), coreCore.assign(nq * nq, 0.0);
   touched.assign(nodeDofs_, 0);
-  for (size_t i = 0; i < effects_.size(); ++i) {
-    const auto& L = effects_[i]->local();
+  for (size_t i = 0; i < effects_.all.size(); ++i) {
+    const auto& L = effects_.all[i]->local();
     if (!L.stiff || coupled_[i].empty()) continue;
     const auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.dofs);
     const auto K = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sinks_[i].kept);
@@ -318,8 +250,8 @@ void Assembly::buildTangentSinks() {
     throw std::logic_error("assembly: an element entry is missing from the matrix graph");
   };
   const auto& supportOf = constraints_.supportOf;
-  for (size_t i = 0; i < effects_.size(); ++i) {
-    const auto& L = effects_[i]->local();
+  for (size_t i = 0; i < effects_.all.size(); ++i) {
+    const auto& L = effects_.all[i]->local();
     sinks_.emplace_back();
     if (!L.stiff) continue;
     TangentSink& sink = sinks_.back();
@@ -531,15 +463,15 @@ bool Assembly::evaluate(const Vector& u, Vector* f, FEMatrix* W, const Vector* z
     W->beginAssembly();
     W->setAllToScalar(0.0);
     const auto values = W->getLocalMatrixDevice().values;
-    for (size_t i = 0; i < effects_.size(); ++i)
-      if (effects_[i]->local().stiff) sinks_[i].values = values;  // the others evaluate without a sink
+    for (size_t i = 0; i < effects_.all.size(); ++i)
+      if (effects_.all[i]->local().stiff) sinks_[i].values = values;  // the others evaluate without a sink
   }
   if (action) {
     if (zOverlap_.is_null()) zOverlap_ = rcp(new Vector(overlapDofMap_));
     zOverlap_->doImport(*z, *importer_, Tpetra::INSERT);
     auto zd = zOverlap_->getData();
-    for (size_t i = 0; i < effects_.size(); ++i) {
-      const auto& L = effects_[i]->local();
+    for (size_t i = 0; i < effects_.all.size(); ++i) {
+      const auto& L = effects_.all[i]->local();
       KzLocal.emplace_back("K z", L.dofs.extent(0), L.dofs.extent(1));  // zero for entities without a tangent
       if (!L.stiff) continue;
       auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.dofs);
@@ -551,12 +483,12 @@ bool Assembly::evaluate(const Vector& u, Vector* f, FEMatrix* W, const Vector* z
       sinks_[i].z = zLocal, sinks_[i].Kz = KzLocal.back();
     }
   }
-  for (size_t i = 0; i < effects_.size(); ++i)
-    effects_[i]->evaluate(x_, u_, W && effects_[i]->local().stiff ? &sinks_[i] : nullptr);
+  for (size_t i = 0; i < effects_.all.size(); ++i)
+    effects_.all[i]->evaluate(x_, u_, W && effects_.all[i]->local().stiff ? &sinks_[i] : nullptr);
   for (auto& sink : sinks_) sink.values = {}, sink.z = {}, sink.Kz = {};  // no stale views kept
 
   double minJ = 1e300;
-  auto elementMinJ = bricks_->minJacobian;
+  auto elementMinJ = effects_.bricks->minJacobian;
   Kokkos::parallel_reduce(
       "min J", Kokkos::RangePolicy<ExecSpace>(0, elementMinJ.extent(0)),
       KOKKOS_LAMBDA(int e, double& m) { m = elementMinJ(e) < m ? elementMinJ(e) : m; },
@@ -570,7 +502,7 @@ bool Assembly::evaluate(const Vector& u, Vector* f, FEMatrix* W, const Vector* z
   // theta-theta entry needs the reactions at the face nodes.
   if (f || (W && !cores_.empty())) {
     std::vector<Matrix> R;
-    for (const auto& effect : effects_) R.push_back(effect->local().R);
+    for (const auto& effect : effects_.all) R.push_back(effect->local().R);
     sumEntityVectors(R);
     auto ro = residual_->getData(0);
     rawOwnedResidual_.assign(ro.begin(), ro.end());
@@ -630,10 +562,10 @@ void Assembly::sumEntityVectors(const std::vector<Matrix>& values) {
   residual_->putScalar(0.0);
   {
     auto r = residual_->getDataNonConst(0);
-    for (size_t i = 0; i < effects_.size(); ++i) {
-      auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), effects_[i]->local().dofs);
+    for (size_t i = 0; i < effects_.all.size(); ++i) {
+      auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), effects_.all[i]->local().dofs);
       auto v = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), values[i]);
-      auto active = activeOnHost(effects_[i]->local());
+      auto active = activeOnHost(effects_.all[i]->local());
       for (size_t e = 0; e < dofs.extent(0); ++e)
         if (!active.size() || active(e))
           for (size_t k = 0; k < dofs.extent(1); ++k) r[overlapLid(dofs(e, k))] += v(e, k);

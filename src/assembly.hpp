@@ -12,17 +12,12 @@
 #include <Tpetra_Vector.hpp>
 
 #include <array>
-#include <map>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "../kernels/rigid_core.hpp"
-#include "effects/body_force.hpp"
-#include "effects/bricks.hpp"
-#include "effects/contact.hpp"
-#include "effects/foundation.hpp"
-#include "effects/friction.hpp"
+#include "effects/factory.hpp"
 #include "mesh.hpp"
 #include "scene.hpp"
 
@@ -82,21 +77,21 @@ class Assembly {
   }
   RCP<FEMatrix> createMatrix() const;
   const Constraints& constraints() const { return constraints_; }
-  BrickEffect& bricks() { return *bricks_; }
-  const std::vector<std::unique_ptr<Effect>>& effects() const { return effects_; }
-  const std::vector<FoundationEffect*>& foundations() const { return foundations_; }
-  const std::vector<ContactEffect*>& contacts() const { return contacts_; }
+  BrickEffect& bricks() { return *effects_.bricks; }
+  const std::vector<std::unique_ptr<Effect>>& effects() const { return effects_.all; }
+  const std::vector<FoundationEffect*>& foundations() const { return effects_.foundations; }
+  const std::vector<ContactEffect*>& contacts() const { return effects_.contacts; }
   // Per capstan (as contacts()): its friction effect, or null without friction.
-  const std::vector<FrictionEffect*>& frictions() const { return frictions_; }
+  const std::vector<FrictionEffect*>& frictions() const { return effects_.frictions; }
   // The union of all capstans' candidate faces on this rank (4 overlapped node
   // ids each), and for capstan i the union index of each of its faces.
-  const std::vector<int>& contactFaceNodes() const { return contactFaceNodes_; }
-  const std::vector<int>& contactFacesOf(size_t capstan) const { return contactFaceOf_[capstan]; }
+  const std::vector<int>& contactFaceNodes() const { return effects_.contactFaceNodes; }
+  const std::vector<int>& contactFacesOf(size_t capstan) const { return effects_.contactFaceOf[capstan]; }
 
   // The increment being solved (effects that move with time evaluate at tEnd).
   void setInterval(double tStart, double tEnd) {
     time_ = tEnd;
-    for (auto& e : effects_) e->setInterval(tStart, tEnd);
+    for (auto& e : effects_.all) e->setInterval(tStart, tEnd);
   }
 
   // Turns the whole body, with each rigid core whose rotation is free, rigidly
@@ -177,14 +172,7 @@ class Assembly {
     std::vector<char> touched;
   } coupling_;
   double time_ = 0;
-  std::vector<std::unique_ptr<Effect>> effects_;
-  BrickEffect* bricks_ = nullptr;
-  std::vector<FoundationEffect*> foundations_;
-  std::vector<ContactEffect*> contacts_;
-  std::vector<FrictionEffect*> frictions_;
-  std::map<std::array<int, 4>, int> contactFaceIndex_;
-  std::vector<int> contactFaceNodes_;
-  std::vector<std::vector<int>> contactFaceOf_;
+  SceneEffects effects_;  // src/effects/factory.hpp: every effect, in evaluation order
   Constraints constraints_;
   RCP<FEGraph> graph_;
   std::vector<std::vector<LO>> columns_;  // per effect: [entity * dofs + k] matrix column ids
