@@ -2,7 +2,8 @@
 // data and launching its Kokkos kernel over its entities (bricks or faces). All
 // of them hand the same things to the one assembly path: per-entity dof ids and
 // residuals (LocalSystem), and each entity's tangent to the assembly's
-// TangentSink as it is formed.
+// TangentSink as it is formed. One file per effect in src/effects/;
+// src/effects/factory.hpp builds those a scene names.
 #pragma once
 
 #include <Kokkos_Core.hpp>
@@ -32,6 +33,11 @@ struct LocalSystem {
   // graph still holds them, so the sparsity pattern never changes.
   Kokkos::View<int*> active;
 };
+
+// An effect's active flags on the host (empty: every entity is active).
+inline Kokkos::View<int*>::HostMirror activeOnHost(const LocalSystem& L) {
+  return Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.active);
+}
 
 // What a kernel does with an active entity's tangent K_e (n x n, row-major,
 // dof 3a+i) right after forming it, while it is still in cache. Element
