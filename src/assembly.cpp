@@ -212,27 +212,63 @@ void Assembly::applyConstraints(Vector& u, double t) {
 }
 
 bool Assembly::evaluate(const Vector& u, Vector* f, FEMatrix* W, const Vector* z, Vector* Kz) {
-  Kokkos::Timer timer;
-  uOverlap_->doImport(u, *importer_, Tpetra::INSERT);
-  {
-    auto ud = uOverlap_->getData();
-    cores_.read(ud);
-    auto hx = Kokkos::create_mirror_view(x_);
-    auto hu = Kokkos::create_mirror_view(u_);
-    for (size_t n = 0; n < mesh_.numOverlapNodes(); ++n)
-      for (int i = 0; i < 3; ++i) {
-        // A core's face node sits where the core puts it, whatever u holds there.
-        hu(n, i) = cores_.coreOf(n) >= 0 ? cores_.follower(n).u[i] : ud[layout_.overlapLid(int(3 * n + i))];
-        hx(n, i) = mesh_.X[3 * n + i] + hu(n, i);
-      }
-    Kokkos::deep_copy(x_, hx);
-    Kokkos::deep_copy(u_, hu);
-  }
-  // The tangent goes straight from each kernel into W's local CRS values
-  // (and into K z for the predictor), entity by entity.
   if (bool(z) != bool(Kz) || (z && !W)) throw std::logic_error("assembly: K z needs z, Kz and the tangent W");
-  const bool action = z != nullptr;
+  Kokkos::Timer timer;
+  auto phase = [&](double& seconds, double& since) {
+    const double now = timer.seconds();
+    seconds += now - since;
+    since = now;
+  };
+  // Each phase writes its own rows of f and K z (node rows, held rows, the
+  // cores' rows); W is exported last, after every phase has added to it.
+  double since = 0;
+  importState(u, z);
+  phase(phases_.import, since);
   std::vector<Matrix> KzLocal;  // per effect: K z per entity (the sinks hold z per entity)
+  const bool valid = launchEffects(W, z, KzLocal);
+  phase(phases_.launch, since);
+  scatterResiduals(f, W, Kz, KzLocal);
+  phase(phases_.scatter, since);
+  constrainRows(f, W);
+  phase(phases_.constraints, since);
+  coupleCores(f, W, Kz);
+  phase(phases_.coreCoupling, since);
+  if (W) W->endAssembly();
+  phase(phases_.matrixExport, since);
+  if (f && !valid) {
+    // An inverted element: a residual Newton cannot mistake for converged.
+    auto out = f->getDataNonConst();
+    for (LO d = 0; d < LO(out.size()); ++d) out[d] = 1e150;
+  }
+  assemblySeconds_ += timer.seconds();
+  return valid;
+}
+
+// u (and z) on the overlapped dofs; the cores' q; the nodes' x and u.
+void Assembly::importState(const Vector& u, const Vector* z) {
+  uOverlap_->doImport(u, *importer_, Tpetra::INSERT);
+  auto ud = uOverlap_->getData();
+  cores_.read(ud);
+  auto hx = Kokkos::create_mirror_view(x_);
+  auto hu = Kokkos::create_mirror_view(u_);
+  for (size_t n = 0; n < mesh_.numOverlapNodes(); ++n)
+    for (int i = 0; i < 3; ++i) {
+      // A core's face node sits where the core puts it, whatever u holds there.
+      hu(n, i) = cores_.coreOf(n) >= 0 ? cores_.follower(n).u[i] : ud[layout_.overlapLid(int(3 * n + i))];
+      hx(n, i) = mesh_.X[3 * n + i] + hu(n, i);
+    }
+  Kokkos::deep_copy(x_, hx);
+  Kokkos::deep_copy(u_, hu);
+  if (z) {
+    if (zOverlap_.is_null()) zOverlap_ = rcp(new Vector(overlapDofMap_));
+    zOverlap_->doImport(*z, *importer_, Tpetra::INSERT);
+  }
+}
+
+// Every effect's kernel. The tangent goes straight from each kernel into W's
+// local CRS values (and into K z for the predictor), entity by entity. Returns
+// whether every element has det F > 0 (global).
+bool Assembly::launchEffects(FEMatrix* W, const Vector* z, std::vector<Matrix>& KzLocal) {
   if (W) {
     W->beginAssembly();
     W->setAllToScalar(0.0);
@@ -240,9 +276,7 @@ bool Assembly::evaluate(const Vector& u, Vector* f, FEMatrix* W, const Vector* z
     for (size_t i = 0; i < effects_.all.size(); ++i)
       if (effects_.all[i]->local().stiff) sinks_[i].values = values;  // the others evaluate without a sink
   }
-  if (action) {
-    if (zOverlap_.is_null()) zOverlap_ = rcp(new Vector(overlapDofMap_));
-    zOverlap_->doImport(*z, *importer_, Tpetra::INSERT);
+  if (z) {
     auto zd = zOverlap_->getData();
     for (size_t i = 0; i < effects_.all.size(); ++i) {
       const auto& L = effects_.all[i]->local();
@@ -269,49 +303,67 @@ bool Assembly::evaluate(const Vector& u, Vector* f, FEMatrix* W, const Vector* z
       Kokkos::Min<double>(minJ));
   double globalMinJ = minJ;
   Teuchos::reduceAll(*mesh_.comm, Teuchos::REDUCE_MIN, minJ, Teuchos::outArg(globalMinJ));
-  const bool valid = globalMinJ > 0 && std::isfinite(globalMinJ);
+  return globalMinJ > 0 && std::isfinite(globalMinJ);
+}
 
-  // The residual; with rigid cores also for the tangent alone, whose
-  // theta-theta entry needs the reactions at the face nodes.
+// The per-entity residuals summed into the owned rows, kept unconstrained for
+// the reactions and the cores' sums, and copied to f's node rows; likewise K z.
+// With rigid cores the residual is also needed for the tangent alone, whose
+// theta-theta entry needs the reactions at the face nodes.
+void Assembly::scatterResiduals(Vector* f, FEMatrix* W, Vector* Kz, const std::vector<Matrix>& KzLocal) {
   if (f || (W && !cores_.empty())) {
     std::vector<Matrix> R;
     for (const auto& effect : effects_.all) R.push_back(effect->local().R);
     sumEntityVectors(R);
     auto ro = residual_->getData(0);
     rawOwnedResidual_.assign(ro.begin(), ro.end());
-    cores_.setReactions(ro.getRawPtr());
     if (f) {
       auto out = f->getDataNonConst();
-      for (LO d = 0; d < LO(out.size()); ++d) {
-        const int a = layout_.assemblyDof(d);
-        if (!valid) out[d] = 1e150;
-        else if (constraints_.held(a)) out[d] = 0.0;
-        else if (a < layout_.nodeDofs) out[d] = ro[d];
-        else out[d] = cores_.residual(a, time_);  // a core's free unknown
-      }
+      for (LO d = 0; d < LO(out.size()); ++d)
+        if (layout_.assemblyDof(d) < layout_.nodeDofs) out[d] = ro[d];
     }
   }
-
-  if (action) {
-    // K z: summed like a residual, then carried to the cores' unknowns.
+  if (Kz) {
+    // K z: summed like a residual (its cores' rows: coupleCores).
     sumEntityVectors(KzLocal);
     auto ro = residual_->getData(0);
-    const auto sums = cores_.sums(ro.getRawPtr());
     auto yd = Kz->getDataNonConst();
-    const int nodeDofs = layout_.nodeDofs;
-    for (LO d = 0; d < LO(yd.size()); ++d) {
+    for (LO d = 0; d < LO(yd.size()); ++d)
+      if (layout_.assemblyDof(d) < layout_.nodeDofs) yd[d] = ro[d];
+  }
+}
+
+// Held rows: f = 0 there, and W has the identity in row and column (the
+// kernels left the held rows and columns out).
+void Assembly::constrainRows(Vector* f, FEMatrix* W) {
+  if (f) {
+    auto out = f->getDataNonConst();
+    for (LO d = 0; d < LO(out.size()); ++d)
+      if (constraints_.held(layout_.assemblyDof(d))) out[d] = 0.0;
+  }
+  if (W) constraints_.setDiagonal(*W);
+}
+
+// The cores' part: the reactions at their face nodes, f's rows of their free
+// unknowns, K z carried to their unknowns, and the chain rule in W.
+void Assembly::coupleCores(Vector* f, FEMatrix* W, Vector* Kz) {
+  if (f || (W && !cores_.empty())) cores_.setReactions(rawOwnedResidual_.data());
+  if (f) {
+    auto out = f->getDataNonConst();
+    for (LO d = 0; d < LO(out.size()); ++d) {
       const int a = layout_.assemblyDof(d);
-      yd[d] = a < nodeDofs ? ro[d] : (a - nodeDofs) % 6 < 4 ? sums[(a - nodeDofs) / 6][(a - nodeDofs) % 6] : 0.0;
+      if (a >= layout_.nodeDofs && !constraints_.held(a)) out[d] = cores_.residual(a, time_);
     }
   }
-
-  if (W) {
-    constraints_.setDiagonal(*W);
-    cores_.assembleCoupling(*W, effects_.all, sinks_, columnOf_, constraints_);
-    W->endAssembly();
+  if (Kz) {
+    auto yd = Kz->getDataNonConst();
+    const auto sums = cores_.sums(yd.getRawPtr());  // over the node rows (K z's owned sums)
+    for (LO d = 0; d < LO(yd.size()); ++d) {
+      const int a = layout_.assemblyDof(d) - layout_.nodeDofs;
+      if (a >= 0) yd[d] = a % 6 < 4 ? sums[a / 6][a % 6] : 0.0;
+    }
   }
-  assemblySeconds_ += timer.seconds();
-  return valid;
+  if (W) cores_.assembleCoupling(*W, effects_.all, sinks_, columnOf_, constraints_);
 }
 
 void Assembly::sumEntityVectors(const std::vector<Matrix>& values) {

@@ -93,8 +93,25 @@ class Assembly {
   const NodalVectors& positions() const { return x_; }
   const NodalVectors& displacements() const { return u_; }
   double assemblySeconds() const { return assemblySeconds_; }
+  // Seconds of evaluate() by phase, summed over the run (not in summary.json).
+  struct PhaseSeconds {
+    double import = 0;         // u (and z) to the overlapped dofs, the nodes' x and u
+    double launch = 0;         // the effects' kernels, their tangents into W, min det F
+    double scatter = 0;        // per-entity residuals (and K z) summed into owned rows
+    double constraints = 0;    // held rows: f = 0, W's unit diagonal
+    double coreCoupling = 0;   // the cores' rows and the chain rule at their face nodes
+    double matrixExport = 0;   // W's shared rows added into their owners
+  };
+  const PhaseSeconds& phaseSeconds() const { return phases_; }
 
  private:
+  // evaluate()'s phases, in order (each timed into phases_).
+  void importState(const Vector& u, const Vector* z);
+  bool launchEffects(FEMatrix* W, const Vector* z, std::vector<Matrix>& KzLocal);
+  void scatterResiduals(Vector* f, FEMatrix* W, Vector* Kz, const std::vector<Matrix>& KzLocal);
+  void constrainRows(Vector* f, FEMatrix* W);
+  void coupleCores(Vector* f, FEMatrix* W, Vector* Kz);
+
   void sumEntityVectors(const std::vector<Matrix>& values);  // into residual_ (owned)
   void buildGraph();
   void buildTangentSinks();
@@ -123,6 +140,7 @@ class Assembly {
   std::vector<double> rawOwnedResidual_;  // the owned residual before constraints (reactions, core sums)
   NodalVectors x_, u_;
   double assemblySeconds_ = 0;
+  PhaseSeconds phases_;
 };
 
 }  // namespace capstan

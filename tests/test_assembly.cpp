@@ -178,6 +178,20 @@ TEST(Assembly, PredictorLoadMatchesMatrixAndDifferences) {
     }
 }
 
+// evaluate()'s phases are timed in turn within its total.
+TEST(Assembly, PhaseSecondsAddUpWithinTheTotal) {
+  BoxProblem problem(boxScene(), 1.0);
+  auto& [scene, mesh, assembly, newton, u, f] = problem;
+  auto W = newton.matrix();
+  ASSERT_TRUE(assembly.evaluate(u, &f, W.get()));
+  ASSERT_TRUE(assembly.evaluate(u, &f, nullptr));
+  const auto& p = assembly.phaseSeconds();
+  for (double s : {p.import, p.launch, p.scatter, p.constraints, p.coreCoupling, p.matrixExport}) EXPECT_GE(s, 0.0);
+  EXPECT_GT(p.launch, 0.0);
+  const double sum = p.import + p.launch + p.scatter + p.constraints + p.coreCoupling + p.matrixExport;
+  EXPECT_LE(sum, assembly.assemblySeconds() * (1 + 1e-12));
+}
+
 // A view's values on the host.
 std::vector<double> hostCopy(const Kokkos::View<double*>& v) {
   auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), v);
