@@ -44,7 +44,7 @@ bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string
   const double r0 = std::min(bare, m_.forceScale);
   const double tol = std::max(sol.newtonRelativeTolerance * r0, m_.absTolerance);
   int maxOuter = sol.maxPressureIterations;
-  for (const auto* c : assembly.contacts()) maxOuter = std::max(maxOuter, c->maxAugmentations());
+  for (const auto& e : effects) maxOuter = std::max(maxOuter, e->maxAugmentations());
   AndersonMixing mixing(sol.pressureAccelerationDepth, m_.comm);
   Vector f(m_.u->getMap());
   for (int it = 1; it <= maxOuter; ++it) {
@@ -100,8 +100,7 @@ bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string
         continue;
       }
       met = false;
-      const auto* contact = dynamic_cast<const ContactEffect*>(e.get());
-      if (contact && it >= contact->maxAugmentations()) {
+      if (e->maxAugmentations() > 0 && it >= e->maxAugmentations()) {
         failure = e->constraintName() + " " + Teuchos::toString(v) + " above its tolerance " +
                   Teuchos::toString(e->constraintTolerance()) + " after " + std::to_string(it) + " augmentations";
         return false;

@@ -5,7 +5,7 @@
 #include <memory>
 #include <vector>
 
-#include "effects.hpp"
+#include "effects/effect.hpp"
 
 namespace capstan {
 

@@ -19,7 +19,7 @@ void Model::checkRanks(const Scene& scene, const Comm& comm) {
 Model::Model(const Scene& scene_, const RCP<const Comm>& comm_)
     : scene(scene_), comm(comm_), rank0(comm_->getRank() == 0) {
   const auto& m = scene.mesh;
-  if (m.type == "Annulus")
+  if (m.type == MeshSpec::Type::Annulus)
     generator = std::make_unique<AnnulusGenerator>(m.center, m.innerRadius, m.outerRadius, m.length, m.cells,
                                                    m.outerCellRatio, m.fineSector);
   else

@@ -41,6 +41,25 @@ int ParameterReader::atLeast(const Teuchos::ParameterList& l, const std::string&
   return x;
 }
 
+double ParameterReader::finite(const Teuchos::ParameterList& l, const std::string& path,
+                               const std::string& name) const {
+  const double x = l.get<double>(name);
+  if (!std::isfinite(x)) fail(path + "/" + name, "must be a finite number");
+  return x;
+}
+
+std::array<bool, 3> ParameterReader::components(const std::string& s, const std::string& path) const {
+  std::array<bool, 3> on{false, false, false};
+  if (s.empty()) fail(path, "empty: name at least one of x, y, z");
+  for (char ch : s) {
+    if (ch == ' ' || ch == ',') continue;
+    if (ch < 'x' || ch > 'z') fail(path, "'" + s + "': components are letters x, y, z");
+    if (on[ch - 'x']) fail(path, "'" + s + "': component " + ch + " listed twice");
+    on[ch - 'x'] = true;
+  }
+  return on;
+}
+
 std::string shortest(double x) {
   std::ostringstream brief, full;
   brief << x;

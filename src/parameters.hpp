@@ -7,6 +7,8 @@
 
 #include <Teuchos_ParameterList.hpp>
 
+#include <array>
+#include <cmath>
 #include <string>
 #include <utility>
 #include <vector>
@@ -35,6 +37,18 @@ struct ParameterReader {
   // In the open interval (0, 1): a relative tolerance.
   double fraction(const Teuchos::ParameterList& list, const std::string& path, const std::string& name) const;
   int atLeast(const Teuchos::ParameterList& list, const std::string& path, const std::string& name, int lowest) const;
+  double finite(const Teuchos::ParameterList& list, const std::string& path, const std::string& name) const;
+  // An Array of exactly 3 finite numbers.
+  template <class T>
+  std::array<T, 3> three(const Teuchos::ParameterList& list, const std::string& path, const std::string& name) const {
+    const auto& a = list.get<Teuchos::Array<T>>(name);
+    if (a.size() != 3) fail(path + "/" + name, "expected 3 values, got " + std::to_string(a.size()));
+    for (const T& x : a)
+      if (!std::isfinite(double(x))) fail(path + "/" + name, "must be finite numbers");
+    return {a[0], a[1], a[2]};
+  }
+  // Components named by letters, e.g. "xz" or "x, z" (at `path`).
+  std::array<bool, 3> components(const std::string& text, const std::string& path) const;
 };
 
 // The name of enum value e in `choices` (the scene's spelling).

@@ -9,7 +9,7 @@
 namespace capstan {
 
 double noSlipAngularVelocity(const Scene& scene, const RigidCore& core) {
-  if (scene.mesh.type != "Annulus") return 0;
+  if (scene.mesh.type != MeshSpec::Type::Annulus) return 0;
   for (const auto& c : scene.capstans) {
     if (c.angularVelocity == 0) continue;
     const double along = dot(core.axisDirection, c.axisDirection) / norm(c.axisDirection);
@@ -20,14 +20,14 @@ double noSlipAngularVelocity(const Scene& scene, const RigidCore& core) {
 
 std::string brakeDiagnosis(const Scene& scene) {
   std::string out;
-  if (scene.mesh.type != "Annulus") return out;
+  if (scene.mesh.type != MeshSpec::Type::Annulus) return out;
   for (const auto& s : scene.supports) {
-    if (s.type != "Rigid Core" || s.rotation != "Free" || s.torque == 0) continue;
+    if (!s.isCore() || s.rotation != SupportSpec::Rotation::Free || s.torque == 0) continue;
     // Friction at most mu |t_n| everywhere, at most the outer radius from the
     // axis: the nip carries at most sum mu |F| R_outer about the core's axis.
     const double F = norm(s.force);
     double mu = 0;
-    for (const auto& c : scene.capstans) mu += c.frictionLaw == "None" ? 0.0 : c.frictionCoefficient;
+    for (const auto& c : scene.capstans) mu += c.friction.on() ? c.friction.coefficient : 0.0;
     const double capacity = mu * F * scene.mesh.outerRadius;
     if (std::fabs(s.torque) > capacity)
       out += "; support '" + s.name + "': its Torque " + brief(s.torque) +

@@ -31,64 +31,6 @@ class Extrema {
   std::vector<double> lo_;
 };
 
-std::array<double, 3> sum3(const Comm& comm, const std::array<double, 3>& local) {
-  std::array<double, 3> global{};
-  Teuchos::reduceAll(comm, Teuchos::REDUCE_SUM, 3, local.data(), global.data());
-  return global;
-}
-
-CapstanRecord capstanFigures(const Model& model, const ContactEffect& contact, const FrictionEffect* friction) {
-  const Comm& comm = *model.comm;
-  CapstanRecord r;
-  r.name = contact.name().substr(std::string("contact:").size());
-  if (friction) {
-    const auto ff = friction->figures();
-    double sums[8] = {ff.force[0], ff.force[1], ff.force[2], ff.torque, ff.frictionIntegral,
-                      ff.normalIntegral, double(ff.stick), double(ff.slip)}, gs[8];
-    Teuchos::reduceAll(comm, Teuchos::REDUCE_SUM, 8, sums, gs);
-    double ratio = 0;
-    Teuchos::reduceAll(comm, Teuchos::REDUCE_MAX, ff.maxRatio, Teuchos::outArg(ratio));
-    r.friction = true;
-    r.force = {gs[0], gs[1], gs[2]};  // the normal contact's share is added below
-    r.torque = gs[3];
-    r.frictionIntegral = gs[4];
-    r.normalIntegral = gs[5];
-    r.stick = long(gs[6]);
-    r.slip = long(gs[7]);
-    r.maxFrictionRatio = ratio;
-  }
-  // Pass 1: sums and maxima. Pass 2: contact angles about the axis, measured
-  // from the direction of the contact's resultant (so the contact arc never
-  // straddles the +-pi cut), for the contact width.
-  auto fig = contact.figures({0, 0, 0});
-  double sums[5] = {fig.force[0], fig.force[1], fig.force[2], fig.torque, fig.area}, gs[5];
-  Teuchos::reduceAll(comm, Teuchos::REDUCE_SUM, 5, sums, gs);
-  double maxima[2] = {fig.maxPenetration, fig.peakPressure}, gm[2];
-  Teuchos::reduceAll(comm, Teuchos::REDUCE_MAX, 2, maxima, gm);
-  long points = 0;
-  Teuchos::reduceAll(comm, Teuchos::REDUCE_SUM, fig.points, Teuchos::outArg(points));
-  for (int i = 0; i < 3; ++i) r.force[i] += gs[i];
-  r.torque += gs[3];
-  r.area = gs[4];
-  r.maxPenetration = gm[0];
-  r.peakPressure = gm[1];
-  r.points = points;
-  // The body pushes the capstan away from itself: the contact lies along -force.
-  const auto& b = contact.axisDirection();
-  Vec3 ref{-gs[0], -gs[1], -gs[2]};
-  const double along = dot(ref, b);
-  for (int i = 0; i < 3; ++i) ref[i] -= along * b[i];
-  const double n = norm(ref);
-  if (points > 0 && n > 0) {
-    for (double& x : ref) x /= n;
-    const auto angles = contact.figures(ref);
-    double lo[2] = {angles.angleMin, -angles.angleMax}, glo[2];
-    Teuchos::reduceAll(comm, Teuchos::REDUCE_MIN, 2, lo, glo);
-    r.width = contact.radius() * (-glo[1] - glo[0]);
-  }
-  return r;
-}
-
 }  // namespace
 
 void measureStep(const Model& model, const std::vector<StepRecord>& earlier, StepRecord& rec) {
@@ -96,13 +38,13 @@ void measureStep(const Model& model, const std::vector<StepRecord>& earlier, Ste
   const auto reactions = assembly.constraintReactions();
   std::map<std::string, std::array<double, 3>> byName;
   for (size_t s = 0; s < reactions.size(); ++s) byName[assembly.constraints().supportNames[s]] = reactions[s];
-  for (auto* f : assembly.foundations())
-    byName[f->name().substr(std::string("foundation:").size())] = sum3(*model.comm, f->localForceOnBody());
   for (const auto& s : model.scene.supports) {
     SupportRecord sr;
     sr.name = s.name, sr.force = byName[s.name];
     rec.supports.push_back(sr);
   }
+  // Foundations and capstans (contact, friction) report themselves.
+  for (const auto& e : assembly.effects()) e->report(*model.comm, rec);
   // Rigid cores: the reactions at the face nodes are the force of the core on
   // the body; angular velocity over the step (formulation: increment / dt).
   for (const auto& core : assembly.rigidCores()) {
@@ -124,8 +66,6 @@ void measureStep(const Model& model, const std::vector<StepRecord>& earlier, Ste
     sr.hasSpeedRatio = rolling != 0;
     if (sr.hasSpeedRatio) sr.speedRatio = sr.angularVelocity / rolling;
   }
-  for (size_t i = 0; i < assembly.contacts().size(); ++i)
-    rec.capstans.push_back(capstanFigures(model, *assembly.contacts()[i], assembly.frictions()[i]));
 }
 
 ElementFields elementFields(const Model& model) {

@@ -141,7 +141,7 @@ TEST_F(SceneTest, ValidSceneLoads) {
   const Scene s = loadScene(file, {}, "");
   EXPECT_EQ(s.file, file);
   EXPECT_EQ(s.title, "test scene");
-  EXPECT_EQ(s.mesh.type, "Box");
+  EXPECT_EQ(s.mesh.type, MeshSpec::Type::Box);
   EXPECT_EQ(s.mesh.cells, (std::array<int, 3>{4, 2, 2}));
   EXPECT_EQ(s.mesh.max, (std::array<double, 3>{2, 1, 1}));
   EXPECT_EQ(s.c, 1.0);
@@ -153,10 +153,10 @@ TEST_F(SceneTest, ValidSceneLoads) {
   EXPECT_EQ(s.supports[0].name, "base");
   EXPECT_EQ(s.supports[0].components, (std::array<bool, 3>{true, true, true}));
   EXPECT_EQ(s.supports[1].name, "pull");
-  EXPECT_EQ(s.supports[1].type, "Displacement");
+  EXPECT_EQ(s.supports[1].type, SupportSpec::Type::Displacement);
   EXPECT_EQ(s.supports[1].components, (std::array<bool, 3>{true, false, false}));
   EXPECT_EQ(s.supports[1].velocity, (std::array<double, 3>{0.2, 0, 0}));
-  EXPECT_EQ(s.supports[2].type, "Foundation");
+  EXPECT_EQ(s.supports[2].type, SupportSpec::Type::Foundation);
   EXPECT_EQ(s.supports[2].stiffness, 1.0);
   EXPECT_TRUE(s.capstans.empty());
 }
@@ -181,7 +181,7 @@ TEST_F(SceneTest, DefaultsAreFilledIn) {
   const Scene s = loadScene(file, {}, "");
   const auto valid = validParameters();
   EXPECT_EQ(s.title, "");
-  EXPECT_EQ(s.mesh.type, "Box");
+  EXPECT_EQ(s.mesh.type, MeshSpec::Type::Box);
   EXPECT_EQ(s.mesh.min, (std::array<double, 3>{0, 0, 0}));
   EXPECT_EQ(s.mesh.max, (std::array<double, 3>{1, 1, 1}));
   EXPECT_EQ(s.mesh.cells, (std::array<int, 3>{2, 3, 4}));
@@ -594,12 +594,12 @@ TEST_F(SceneTest, CapstanOfG1) {
   EXPECT_EQ(c.axisDirection, (std::array<double, 3>{0, 0, 1}));
   EXPECT_EQ(c.velocity, (std::array<double, 3>{0, -0.1, 0}));
   EXPECT_EQ(c.contactFaces, (std::vector<std::string>{"ymax"}));
-  EXPECT_EQ(c.method, "Augmented Lagrangian");
-  EXPECT_EQ(c.quadrature, 2) << "Auto: the augmented Lagrangian uses the nodal rule";
-  EXPECT_LT(c.minimumSolvePenalty, 0) << "automatic solve penalty by default";
+  EXPECT_EQ(c.contact.method, ContactSettings::Method::AugmentedLagrangian);
+  EXPECT_EQ(c.contact.quadrature, ContactSettings::Quadrature::Nodal) << "Auto: the augmented Lagrangian uses the nodal rule";
+  EXPECT_LT(c.contact.minimumSolvePenalty, 0) << "automatic solve penalty by default";
   const Scene p = loadScene(std::string(CAPSTAN_INPUTS_DIR) + "/seed/g1.xml",
                             {"Capstans/capstan/Contact/Method=Penalty"}, "");
-  EXPECT_EQ(p.capstans[0].quadrature, 0) << "Auto: the penalty method uses Gauss 2x2";
+  EXPECT_EQ(p.capstans[0].contact.quadrature, ContactSettings::Quadrature::Gauss2x2) << "Auto: the penalty method uses Gauss 2x2";
 }
 
 TEST_F(SceneTest, CapstanInputErrors) {
