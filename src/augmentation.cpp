@@ -67,7 +67,8 @@ bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string
       text += format("  (%d linear; preconditioners built: %d; %.3f s)", r.linearIterations,
                      m_.newton->preconditionerBuilds(), solveSeconds);
       std::vector<double> history(r.residualHistory.begin(), r.residualHistory.end());
-      log_.event("newton", text,
+      if (log_.on("newton"))
+        log_.event("newton", text,
                  eventOf("newton").add("pass", json::number(it)).add("residuals", json::array(history))
                      .add("converged", r.converged ? "true" : "false")
                      .add("linear_iterations", json::number(r.linearIterations))
@@ -92,7 +93,8 @@ bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string
         rec.volumeChange = v, volumeMet = v <= e->constraintTolerance();
         if (m_.pressureStep) m_.pressureStep->measuredAfterNewton(v);
       }
-      log_.event("newton", format("%s: %.3e (tolerance %.1e)", e->constraintName().c_str(), v, e->constraintTolerance()),
+      if (log_.on("newton"))
+        log_.event("newton", format("%s: %.3e (tolerance %.1e)", e->constraintName().c_str(), v, e->constraintTolerance()),
                  eventOf("constraint").add("name", json::string(e->constraintName())).add("violation", json::number(v))
                      .add("tolerance", json::number(e->constraintTolerance())));
       if (v <= e->constraintTolerance()) {
@@ -149,7 +151,8 @@ bool AugmentationLoop::saddlePointPressureStep(double t, Vector& f, StepRecord& 
   }
   rec.linear += step.iterations;
   rec.pressureStep += step.iterations;
-  log_.event("newton",
+  if (log_.on("newton"))
+    log_.event("newton",
              format("pressure step: %d GMRES iterations, residual reduced %.2e, volume error left %.2e "
                     "(stopped on the prediction after Newton %.2e, target %.2e, %d checks), %d contact rows; %.3f s",
                     step.iterations, step.reduction, step.volumeResidual, step.volumePredicted,

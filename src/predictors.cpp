@@ -43,7 +43,8 @@ bool Predictors::extrapolate(double t0, double t, double bare, Vector& f) {
   m_.assembly->applyConstraints(trial, t);
   const bool valid = m_.assembly->evaluate(trial, &f, nullptr);
   const double norm = f.norm2();  // collective: every rank
-  log_.event("newton", format("extrapolated: valid %d |R| %.3e bare %.3e", int(valid), norm, bare),
+  if (log_.on("newton"))
+    log_.event("newton", format("extrapolated: valid %d |R| %.3e bare %.3e", int(valid), norm, bare),
              json::Object().add("event", json::string("extrapolation")).add("valid", valid ? "true" : "false")
                  .add("residual", json::number(norm)).add("bare", json::number(bare)));
   if (!(valid && norm < bare)) return false;
@@ -66,7 +67,8 @@ bool Predictors::rollWithCores(double t0, double t) {
   }
   if (std::none_of(dTheta.begin(), dTheta.end(), [](double x) { return x != 0; })) return false;
   m_.assembly->rollWithCores(*m_.u, dTheta);
-  log_.event("newton", format("rolled by %.4g", dTheta[0]),
+  if (log_.on("newton"))
+    log_.event("newton", format("rolled by %.4g", dTheta[0]),
              json::Object().add("event", json::string("rolled")).add("angle", json::number(dTheta[0])));
   return true;
 }
@@ -115,7 +117,8 @@ void Predictors::tangent(double t0, double t1, double bare, StepRecord& rec) {
     assembly.applyConstraints(trial, t1);
     const bool valid = assembly.evaluate(trial, &f, nullptr);
     const double norm = f.norm2();  // collective: every rank
-    log_.event("newton", format("predictor alpha %g valid %d |R| %.3e bare %.3e", alpha, int(valid), norm, bare),
+    if (log_.on("newton"))
+      log_.event("newton", format("predictor alpha %g valid %d |R| %.3e bare %.3e", alpha, int(valid), norm, bare),
                json::Object().add("event", json::string("predictor")).add("alpha", json::number(alpha))
                    .add("valid", valid ? "true" : "false").add("residual", json::number(norm))
                    .add("bare", json::number(bare)));
