@@ -3,6 +3,7 @@
 #include <Teuchos_XMLParameterListHelpers.hpp>
 #include <Tpetra_Core.hpp>
 
+#include <algorithm>
 #include <cstring>
 #include <iostream>
 #include <string>
@@ -10,6 +11,7 @@
 
 #include "errors.hpp"
 #include "heap_tunables.hpp"
+#include "log.hpp"
 #include "scene.hpp"
 #include "simulation.hpp"
 
@@ -17,6 +19,7 @@ namespace {
 
 const char* kUsage =
     "usage: capstan run SCENE.xml [--output DIR] [--set PATH=VALUE]... [--restart DIR] [--quiet]\n"
+    "                             [--log TOPIC]... [--check-tangent]\n"
     "       capstan validate SCENE.xml [--set PATH=VALUE]...\n"
     "       capstan params\n"
     "       capstan --version\n"
@@ -27,12 +30,16 @@ const char* kUsage =
     "                    earlier run of the scene with Output/Checkpoint Every > 0 (same mesh,\n"
     "                    step size and number of ranks); outputs list every step\n"
     "  --quiet           no progress lines\n"
+    "  --log TOPIC       log the method's inner events on stdout and in OUTDIR/log.jsonl;\n"
+    "                    topics: newton (Newton histories, constraints, predictors, pressure steps)\n"
+    "  --check-tangent   compare the assembled tangent with differences of the residual\n"
+    "                    before each Newton solve (a debugging aid; slow)\n"
     "exit status: 0 converged, 1 bad input (nothing written), 2 did not converge\n";
 
 struct Args {
   std::string command, scene, output, restart;
-  std::vector<std::string> sets;
-  bool quiet = false;
+  std::vector<std::string> sets, log;
+  bool quiet = false, checkTangent = false;
 };
 
 // Returns false (with a message) on a malformed command line.
@@ -56,6 +63,14 @@ bool parse(int argc, char** argv, Args& a, std::string& error) {
       else if (s == "--restart") a.restart = value("--restart");
       else if (s.rfind("--restart=", 0) == 0) a.restart = s.substr(10);
       else if (s == "--quiet") a.quiet = true;
+      else if (s == "--check-tangent") a.checkTangent = true;
+      else if (s == "--log" || s.rfind("--log=", 0) == 0) {
+        const std::string topic = s == "--log" ? value("--log") : s.substr(6);
+        const auto& topics = capstan::Log::topics();
+        if (std::find(topics.begin(), topics.end(), topic) == topics.end())
+          throw std::runtime_error("--log: unknown topic '" + topic + "' (topics: newton)");
+        a.log.push_back(topic);
+      }
       else if (!s.empty() && s[0] == '-') throw std::runtime_error("unknown option " + s);
       else if (a.scene.empty()) a.scene = s;
       else throw std::runtime_error("unexpected argument " + s);
@@ -101,8 +116,8 @@ int main(int argc, char** argv) {
     if (rank0) std::cerr << "capstan: " << args.command << " needs a scene file\n" << kUsage;
     return 1;
   }
-  if (!args.restart.empty() && args.command != "run") {
-    if (rank0) std::cerr << "capstan: --restart applies to run only\n" << kUsage;
+  if ((!args.restart.empty() || !args.log.empty() || args.checkTangent) && args.command != "run") {
+    if (rank0) std::cerr << "capstan: --restart, --log and --check-tangent apply to run only\n" << kUsage;
     return 1;
   }
   try {
@@ -113,7 +128,7 @@ int main(int argc, char** argv) {
       if (rank0) Teuchos::writeParameterListToXmlOStream(scene.resolved, std::cout);
       return 0;
     }
-    return capstan::runScene(scene, comm, {args.quiet, args.restart});
+    return capstan::runScene(scene, comm, {args.quiet, args.restart, args.log, args.checkTangent});
   } catch (const capstan::InputError& e) {
     if (rank0) std::cerr << "capstan: error: " << e.what() << "\n";
     return 1;

@@ -5,7 +5,7 @@
 //     x = A + T + R(theta) (X - A),    so    u = T + (R(theta) - I)(X - A),
 //
 // and the body's residual at the face's nodes reaches the core's unknowns
-// q = (T, theta) through the chain rule (src/assembly.cpp):
+// q = (T, theta) through the chain rule (src/rigid_cores.cpp):
 //
 //     du/dT = I,   du/dtheta = b = d x R(X - A),   d2u/dtheta2 = w = d x b.
 //

@@ -10,8 +10,8 @@ tolerances, a reused preconditioner) switched off one at a time.
 
 --pressure-update: Solver/Pressure Update of every run (default Anderson,
 with the solve penalty it had then, 1e-2: the pressure loop of the figures in
-docs/performance.md; Auto runs today's default, the saddle-point step, whose
-own figures are in the "pressure loop" section there).
+docs/performance.md; Auto runs today's default, the saddle-point step: see
+"Defaults and why" there).
 
 --steps: load steps of every run (Time/Steps; default 5, the whole G1); the
 eps1 and cost-saver runs only where the factors include 1.

@@ -16,8 +16,8 @@ count runs the same method, and writes
                        [--steps N] [--capstan build/capstan] [--set PATH=VALUE]...
 
 Runs whose summary.json exists are reused (delete OUT/<run>/ to redo one); a
-run made by hand may leave its CAPSTAN_NEWTON_LOG=1 output in OUT/<run>/run.log,
-from which the pressure steps' iterations are read if its summary lacks them.
+run made by hand with --log newton leaves OUT/<run>/log.jsonl, from which the
+pressure steps' iterations are read if its summary lacks them.
 --steps N runs only the first N steps of each scene (the per-step and
 per-Newton figures stay comparable; the totals do not). The 8x G1 (550k
 DOFs, --g1 8) takes 4-13 minutes on 2 ranks and 6-20 on 1, by machine (docs/performance.md).
@@ -58,10 +58,10 @@ for case, f in plan:
         s = summary(out, command(args.capstan, scene, out, cells, ranks, args.set, args.steps), tag, "scaling.py")
         steps = s["steps"]
         newton, linear, pstep = totals(s)
-        log = os.path.join(out, "run.log")  # a run made by hand with CAPSTAN_NEWTON_LOG=1
+        log = os.path.join(out, "log.jsonl")  # a run made by hand with --log newton
         if pstep is None and os.path.isfile(log):
             with open(log) as fh:
-                pstep = sum(int(line.split()[2]) for line in fh if line.strip().startswith("pressure step:"))
+                pstep = sum(e.get("iterations", 0) for e in map(json.loads, fh) if e.get("event") == "pressure_step")
         t = s["timing"]
         rows.append({
             "case": case, "factor": f, "cells": "x".join(map(str, cells)), "ranks": ranks,

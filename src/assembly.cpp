@@ -4,142 +4,35 @@
 #include <Teuchos_CommHelpers.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
-#include <set>
+#include <stdexcept>
 
 namespace capstan {
 
-namespace {
-// An effect's active flags on the host (empty: every entity is active).
-Kokkos::View<int*>::HostMirror activeOnHost(const LocalSystem& L) {
-  return Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.active);
-}
-}  // namespace
-
-Assembly::Assembly(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
-  // Effects the scene calls for, and nothing else.
-  const double epsSolve =
-      std::max(scene.pressurePenalty, scene.solver.get<double>("Minimum Solve Penalty") / scene.c);
-  auto bricks = std::make_unique<BrickEffect>(mesh, scene.c, epsSolve,
-                                              scene.solver.get<double>("Volume Tolerance"));
-  bricks_ = bricks.get();
-  effects_.push_back(std::move(bricks));
-  nodeDofs_ = int(3 * mesh.numOverlapNodes());
-  // Rigid cores first: their face nodes follow the core whatever other
-  // support also names them.
-  coreOfNode_.assign(mesh.numOverlapNodes(), -1);
-  for (const auto& s : scene.supports) {
-    if (s.type != "Rigid Core") continue;
-    RigidCore core;
-    core.name = s.name;
-    core.axisPoint = s.axisPoint, core.axisDirection = s.axisDirection, core.force = s.force;
-    core.torque = s.torque, core.rampTime = s.rampTime;
-    core.free = {s.freeTranslation[0], s.freeTranslation[1], s.freeTranslation[2], s.rotation == "Free"};
-    core.firstDof = nodeDofs_ + 6 * int(cores_.size());
-    for (int n : mesh.faceNodes(s.face))
-      if (coreOfNode_[n] < 0) coreOfNode_[n] = int(cores_.size());
-    cores_.push_back(core);
-  }
-  const size_t ndof = size_t(nodeDofs_) + 6 * cores_.size();
-  constraints_.supportOf.assign(ndof, -1);
-  constraints_.velocity.assign(ndof, 0.0);
-  for (const auto& s : scene.supports) {
-    if (s.type == "Foundation") {
-      auto f = std::make_unique<FoundationEffect>("foundation:" + s.name, mesh, s.face, s.stiffness,
-                                                  s.components);
-      foundations_.push_back(f.get());
-      effects_.push_back(std::move(f));
-      continue;
-    }
-    const int id = int(constraints_.supportNames.size());
-    constraints_.supportNames.push_back(s.name);
-    if (s.type == "Rigid Core") {
-      auto& core = *std::find_if(cores_.begin(), cores_.end(), [&](const RigidCore& c) { return c.name == s.name; });
-      core.support = id;
-      for (size_t n = 0; n < coreOfNode_.size(); ++n)
-        if (coreOfNode_[n] == int(&core - cores_.data()))
-          for (int i = 0; i < 3; ++i) constraints_.supportOf[3 * n + i] = id;
-      for (int j = 0; j < 6; ++j) {
-        if (j < 4 && core.free[j]) continue;  // an unknown of the Newton solve
-        constraints_.supportOf[core.firstDof + j] = id;
-        constraints_.velocity[core.firstDof + j] = j == 3 && s.rotation == "Prescribed" ? s.angularVelocity : 0.0;
-      }
-      continue;
-    }
-    // Fixed, Roller, Displacement: the first support in the scene that holds a
-    // dof owns it (and its reaction).
-    for (int n : mesh.faceNodes(s.face))
-      for (int i = 0; i < 3; ++i) {
-        if (!s.components[i] || constraints_.supportOf[3 * n + i] >= 0) continue;
-        constraints_.supportOf[3 * n + i] = id;
-        constraints_.velocity[3 * n + i] = s.type == "Displacement" ? s.velocity[i] : 0.0;
-      }
-  }
-
-  if (scene.bodyForce != std::array<double, 3>{0, 0, 0})
-    effects_.push_back(std::make_unique<BodyForceEffect>(mesh, scene.bodyForce, scene.steps * scene.stepSize));
-
-  for (const auto& c : scene.capstans) {
-    ContactEffect::Settings set;
-    set.radius = c.radius;
-    set.axisPoint = c.axisPoint;
-    set.axisDirection = c.axisDirection;
-    set.velocity = c.velocity;
-    set.penalty = c.penalty;
-    set.exact = c.method == "Augmented Lagrangian";
-    set.minimumSolvePenalty = c.minimumSolvePenalty;
-    set.c = scene.c;
-    set.tolerance = c.penetrationTolerance;
-    set.maxAugmentations = c.maxAugmentations;
-    set.rule = c.quadrature;
-    set.smoothing = c.smoothing;
-    // Candidate faces, each once even if two named faces share one. Every
-    // capstan's faces also get an index in the union of all candidate faces
-    // (the contact-face grid of fields.h5).
-    std::vector<int> quads;
-    std::set<std::array<int, 4>> mine;
-    contactFaceOf_.emplace_back();
-    for (const auto& name : c.contactFaces) {
-      const auto& q = mesh.faces.at(name);
-      for (size_t f = 0; f < q.size(); f += 4) {
-        std::array<int, 4> key{q[f], q[f + 1], q[f + 2], q[f + 3]};
-        std::sort(key.begin(), key.end());
-        if (!mine.insert(key).second) continue;
-        auto [it, fresh] = contactFaceIndex_.insert({key, int(contactFaceIndex_.size())});
-        if (fresh) contactFaceNodes_.insert(contactFaceNodes_.end(), q.begin() + f, q.begin() + f + 4);
-        quads.insert(quads.end(), q.begin() + f, q.begin() + f + 4);
-        contactFaceOf_.back().push_back(it->second);
-      }
-    }
-    auto effect = std::make_unique<ContactEffect>("contact:" + c.name, mesh, quads, set);
-    contacts_.push_back(effect.get());
-    frictions_.push_back(nullptr);
-    const ContactEffect& contact = *effect;
-    effects_.push_back(std::move(effect));
-    if (c.frictionLaw == "None") continue;  // no friction kernel at all
-    FrictionEffect::Settings fs;
-    fs.law = c.frictionLaw == "Tanh"     ? kernels::FrictionLaw::Tanh
-             : c.frictionLaw == "Arctan" ? kernels::FrictionLaw::Arctan
-                                         : kernels::FrictionLaw::Coulomb;
-    fs.mu = c.frictionCoefficient;
-    fs.regularization = c.regularization;
-    fs.tangentPenalty = c.tangentialPenalty;
-    fs.smoothing = c.frictionSmoothing;
-    fs.angularVelocity = c.angularVelocity;
-    auto friction = std::make_unique<FrictionEffect>("friction:" + c.name, mesh, quads, contact, fs);
-    frictions_.back() = friction.get();
-    effects_.push_back(std::move(friction));
-  }
-
-  // Graph from every effect's entities: built once, fixed sparsity. An entity
-  // with a core's face node also couples to the core's free unknowns.
+Assembly::Assembly(const Mesh& mesh, const Scene& scene)
+    : mesh_(mesh), effects_(buildEffects(mesh, scene)), cores_(mesh, scene), constraints_(mesh, scene, cores_),
+      layout_(cores_.layout()) {
   buildDofMaps();
   importer_ = rcp(new Tpetra::Import<>(ownedDofMap_, overlapDofMap_));
+  buildGraph();
+  buildTangentSinks();
+  uOverlap_ = rcp(new Vector(overlapDofMap_));
+  residual_ = rcp(new Tpetra::FEMultiVector<>(ownedDofMap_, importer_, 1));
+  x_ = NodalVectors("x", mesh.numOverlapNodes());
+  u_ = NodalVectors("u", mesh.numOverlapNodes());
+  cores_.read(uOverlap_->getData());  // the undeformed state until the first evaluation
+}
+
+// Graph from every effect's entities: built once, fixed sparsity. An entity
+// with a core's face node also couples to the core's free unknowns.
+void Assembly::buildGraph() {
   // Global column ids: the owner of a shared row also receives columns that only
   // other ranks' elements touch, so the column map is built by Tpetra after the
   // export, not taken from this rank's nodes.
   const auto& overlap = *overlapDofMap_;
-  auto gid = [&](int dof) { return overlap.getGlobalElement(overlapLid(dof)); };
+  auto gid = [&](int dof) { return overlap.getGlobalElement(layout_.overlapLid(dof)); };
+  cores_.findCoupling(effects_.all);
   if (cores_.empty()) {
     graph_ = rcp(new FEGraph(ownedDofMap_, overlapDofMap_, 81, importer_));
   } else {
@@ -148,47 +41,26 @@ Assembly::Assembly(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
     Kokkos::DualView<size_t*, FEGraph::device_type> perRow("entries per row", overlap.getNodeNumElements());
     auto h = perRow.view_host();
     Kokkos::deep_copy(h, size_t(81 + 4 * cores_.size()));
-    std::vector<std::vector<char>> seen(cores_.size(), std::vector<char>(constraints_.supportOf.size(), 0));
-    for (const auto& effect : effects_) {
-      if (!effect->local().stiff) continue;
-      auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), effect->local().dofs);
-      for (size_t e = 0; e < dofs.extent(0); ++e)
-        for (size_t k = 0; k < dofs.extent(1); ++k) {
-          const int c = coreOfNode_[dofs(e, k) / 3];
-          if (c >= 0)
-            for (size_t l = 0; l < dofs.extent(1); ++l) seen[c][dofs(e, l)] = 1;
-        }
-    }
-    for (size_t c = 0; c < cores_.size(); ++c) {
-      const size_t count = std::count(seen[c].begin(), seen[c].end(), char(1)) + 6 * cores_.size();
-      for (int j = 0; j < 6; ++j) h(overlapLid(cores_[c].firstDof + j)) = count;
-    }
+    for (size_t c = 0; c < cores_.size(); ++c)
+      for (int j = 0; j < 6; ++j) h(layout_.overlapLid(cores_.records()[c].firstDof + j)) = cores_.rowEntries(c);
     perRow.modify_host();
     perRow.sync_device();
     graph_ = rcp(new FEGraph(ownedDofMap_, overlapDofMap_, perRow, importer_));
   }
   graph_->beginAssembly();
-  for (const auto& effect : effects_) {
-    coupled_.emplace_back();
+  for (const auto& effect : effects_.all) {
     if (!effect->local().stiff) continue;  // no stiffness, no graph entries
     auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), effect->local().dofs);
     std::vector<GO> cols;
     for (size_t e = 0; e < dofs.extent(0); ++e) {
       cols.clear();
-      std::set<int> cores;
-      for (size_t k = 0; k < dofs.extent(1); ++k) {
-        cols.push_back(gid(dofs(e, k)));
-        if (coreOfNode_[dofs(e, k) / 3] >= 0) cores.insert(coreOfNode_[dofs(e, k) / 3]);
-      }
-      for (int c : cores)
-        for (int j = 0; j < 4; ++j)
-          if (cores_[c].free[j]) cols.push_back(gid(cores_[c].firstDof + j));
-      if (!cores.empty()) coupled_.back().push_back(int(e));
+      for (size_t k = 0; k < dofs.extent(1); ++k) cols.push_back(gid(dofs(e, k)));
+      cores_.appendFreeUnknowns(&dofs(e, 0), dofs.extent(1), gid, cols);
       for (GO row : cols) graph_->insertGlobalIndices(row, Teuchos::ArrayView<const GO>(cols));
     }
   }
-  if (coresOwned_)  // the cores' held dofs get their unit diagonal
-    for (const auto& core : cores_)
+  if (layout_.coresOwned)  // the cores' held dofs get their unit diagonal
+    for (const auto& core : cores_.records())
       for (int j = 0; j < 6; ++j) {
         const GO g = gid(core.firstDof + j);
         graph_->insertGlobalIndices(g, Teuchos::ArrayView<const GO>(&g, 1));
@@ -196,9 +68,9 @@ Assembly::Assembly(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
   graph_->endAssembly();
   // Each effect's dofs as local column ids of the assembled matrix.
   const auto& colMap = *graph_->getColMap();
-  columnOf_.resize(constraints_.supportOf.size());
+  columnOf_.resize(layout_.size());
   for (size_t d = 0; d < columnOf_.size(); ++d) columnOf_[d] = colMap.getLocalElement(gid(int(d)));
-  for (const auto& effect : effects_) {
+  for (const auto& effect : effects_.all) {
     if (!effect->local().stiff) {
       columns_.emplace_back();
       continue;
@@ -208,97 +80,6 @@ Assembly::Assembly(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
     for (size_t e = 0; e < dofs.extent(0); ++e)
       for (size_t k = 0; k < dofs.extent(1); ++k) cols[e * dofs.extent(1) + k] = columnOf_[dofs(e, k)];
     columns_.push_back(std::move(cols));
-  }
-  buildTangentSinks();
-  uOverlap_ = rcp(new Vector(overlapDofMap_));
-  residual_ = rcp(new Tpetra::FEMultiVector<>(ownedDofMap_, importer_, 1));
-  x_ = NodalVectors("x", mesh.numOverlapNodes());
-  u_ = NodalVectors("u", mesh.numOverlapNodes());
-  readCores(uOverlap_->getData());  // the undeformed state until the first evaluation
-}
-
-void Assembly::assembleCoreCoupling(FEMatrix& W) {
-  if (cores_.empty()) return;
-  // The chain rule for u_s = T + (R(theta) - I)(X_s - A) at each face node s,
-  // with B_s = du_s/dq = [I | b_s]: element entries K(k, s) go to K(k, q) B_s,
-  // K(s, l) to B_s^T K(s, l), K(s, s') to B_s^T K B_s'; and
-  // d(sum_s R_s . b_s)/dtheta adds sum_s R_s . w_s to (theta, theta).
-  // Accumulated per element in dense arrays, then added row by row.
-  const auto& supportOf = constraints_.supportOf;
-  const size_t nc = cores_.size(), nq = 4 * nc;
-  // Scratch kept between assemblies (no allocation per evaluation).
-  auto& toCore = coupling_.toCore;
-  auto& fromCore = coupling_.fromCore;
-  auto& coreCore = coupling_.coreCore;
-  auto& touched = coupling_.touched;
-  toCore.assign(nq * nodeDofs_, 0.0), fromCore.assign(nq * nodeDofs_, 0.0), coreCore.assign(nq * nq, 0.0);
-  touched.assign(nodeDofs_, 0);
-  for (size_t i = 0; i < effects_.size(); ++i) {
-    const auto& L = effects_[i]->local();
-    if (!L.stiff || coupled_[i].empty()) continue;
-    const auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.dofs);
-    const auto K = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sinks_[i].kept);
-    const auto active = activeOnHost(L);
-    const int n = int(dofs.extent(1));
-    std::vector<std::array<double, 4>> B(n);
-    std::vector<int> coreOf(n);
-    for (size_t slot = 0; slot < coupled_[i].size(); ++slot) {
-      const int e = coupled_[i][slot];
-      if (active.size() && !active(e)) continue;
-      for (int k = 0; k < n; ++k) {
-        const int d = dofs(e, k), c = coreOfNode_[d / 3];
-        coreOf[k] = c;
-        if (c >= 0) B[k] = coreChain(d);
-      }
-      for (int k = 0; k < n; ++k)
-        for (int l = 0; l < n; ++l) {
-          const int ck = coreOf[k], cl = coreOf[l], dk = dofs(e, k), dl = dofs(e, l);
-          const double Kkl = K(slot, k, l);
-          if ((ck < 0 && cl < 0) || Kkl == 0) continue;
-          if (ck < 0) {
-            if (supportOf[dk] >= 0) continue;
-            touched[dk] = 1;
-            for (int j = 0; j < 4; ++j) toCore[(4 * cl + j) * nodeDofs_ + dk] += Kkl * B[l][j];
-          } else if (cl < 0) {
-            if (supportOf[dl] >= 0) continue;
-            touched[dl] = 1;
-            for (int j = 0; j < 4; ++j) fromCore[(4 * ck + j) * nodeDofs_ + dl] += B[k][j] * Kkl;
-          } else {
-            for (int a = 0; a < 4; ++a)
-              for (int b = 0; b < 4; ++b) coreCore[(4 * ck + a) * nq + 4 * cl + b] += B[k][a] * Kkl * B[l][b];
-          }
-        }
-    }
-  }
-  std::vector<LO> cols;
-  std::vector<double> vals;
-  auto add = [&](LO row) {
-    const LO added = W.sumIntoLocalValues(row, Teuchos::ArrayView<const LO>(cols), Teuchos::ArrayView<const double>(vals));
-    if (added != LO(cols.size())) throw std::logic_error("assembly: a rigid-core entry is missing from the matrix graph");
-  };
-  auto freeCoreDof = [&](size_t q) { return cores_[q / 4].free[q % 4]; };
-  auto coreDof = [&](size_t q) { return cores_[q / 4].firstDof + int(q % 4); };
-  for (int d = 0; d < nodeDofs_; ++d) {
-    if (!touched[d]) continue;
-    cols.clear(), vals.clear();
-    for (size_t q = 0; q < nq; ++q)
-      if (freeCoreDof(q) && toCore[q * nodeDofs_ + d] != 0)
-        cols.push_back(columnOf_[coreDof(q)]), vals.push_back(toCore[q * nodeDofs_ + d]);
-    if (!cols.empty()) add(overlapLid(d));
-  }
-  for (size_t q = 0; q < nq; ++q) {
-    if (!freeCoreDof(q)) continue;
-    cols.clear(), vals.clear();
-    for (int d = 0; d < nodeDofs_; ++d)
-      if (touched[d] && fromCore[q * nodeDofs_ + d] != 0)
-        cols.push_back(columnOf_[d]), vals.push_back(fromCore[q * nodeDofs_ + d]);
-    for (size_t p = 0; p < nq; ++p) {
-      double v = coreCore[q * nq + p];
-      // The reactions are global sums: rank 0 adds the geometric term once.
-      if (p == q && q % 4 == 3 && coresOwned_) v += cores_[q / 4].geometric;
-      if (freeCoreDof(p) && v != 0) cols.push_back(columnOf_[coreDof(p)]), vals.push_back(v);
-    }
-    if (!cols.empty()) add(overlapLid(coreDof(q)));
   }
 }
 
@@ -318,8 +99,8 @@ void Assembly::buildTangentSinks() {
     throw std::logic_error("assembly: an element entry is missing from the matrix graph");
   };
   const auto& supportOf = constraints_.supportOf;
-  for (size_t i = 0; i < effects_.size(); ++i) {
-    const auto& L = effects_[i]->local();
+  for (size_t i = 0; i < effects_.all.size(); ++i) {
+    const auto& L = effects_.all[i]->local();
     sinks_.emplace_back();
     if (!L.stiff) continue;
     TangentSink& sink = sinks_.back();
@@ -344,7 +125,7 @@ void Assembly::buildTangentSinks() {
           // consecutive column ids, and each row's entries are sorted).
           for (size_t j = 0; j < 3; ++j) {
             if (held & (1 << (3 * b + j))) continue;
-            const int at = find(overlapLid(dofs(e, k)), columns_[i][e * n + 3 * b + j]) - int(j);
+            const int at = find(layout_.overlapLid(dofs(e, k)), columns_[i][e * n + 3 * b + j]) - int(j);
             if (o >= 0 && at != o)
               throw std::logic_error("assembly: a node's 3 columns are not side by side in a matrix row");
             o = at;
@@ -354,22 +135,17 @@ void Assembly::buildTangentSinks() {
     }
     Kokkos::deep_copy(sink.rowBlock, hb);
     Kokkos::deep_copy(sink.heldColumns, hh);
-    if (!coupled_[i].empty()) {
+    const auto& coupled = cores_.coupled(i);
+    if (!coupled.empty()) {
       sink.keepSlot = Kokkos::View<int*>("tangent keep slot", ne);
-      sink.kept = decltype(sink.kept)("kept tangents", coupled_[i].size(), n, n);
+      sink.kept = decltype(sink.kept)("kept tangents", coupled.size(), n, n);
       auto hk = Kokkos::create_mirror_view(sink.keepSlot);
       Kokkos::deep_copy(hk, -1);
-      for (size_t slot = 0; slot < coupled_[i].size(); ++slot) hk(coupled_[i][slot]) = int(slot);
+      for (size_t slot = 0; slot < coupled.size(); ++slot) hk(coupled[slot]) = int(slot);
       Kokkos::deep_copy(sink.keepSlot, hk);
     }
   }
-  std::vector<int> diagonal;
-  for (LO d = 0; d < LO(ownedDofMap_->getNodeNumElements()); ++d)
-    if (supportOf[assemblyDof(d)] >= 0) diagonal.push_back(find(d, columnOf_[assemblyDof(d)]));
-  constrainedDiagonal_ = Kokkos::View<int*>("constrained diagonal", diagonal.size());
-  auto hd = Kokkos::create_mirror_view(constrainedDiagonal_);
-  for (size_t j = 0; j < diagonal.size(); ++j) hd(j) = diagonal[j];
-  Kokkos::deep_copy(constrainedDiagonal_, hd);
+  constraints_.locateDiagonal(LO(ownedDofMap_->getNodeNumElements()), columnOf_, find);
   W->endAssembly();
 }
 
@@ -379,8 +155,7 @@ void Assembly::chainRows(const Effect& e, const Matrix& values, std::vector<size
                          std::vector<GO>& cols, std::vector<double>& vals, const std::vector<int>* entities) const {
   auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), e.local().dofs);
   auto v = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), values);
-  const auto& supportOf = constraints_.supportOf;
-  auto gid = [&](int dof) { return overlapDofMap_->getGlobalElement(overlapLid(dof)); };
+  auto gid = [&](int dof) { return overlapDofMap_->getGlobalElement(layout_.overlapLid(dof)); };
   rowStart.assign(1, 0), cols.clear(), vals.clear();
   for (size_t k = 0; k < v.extent(0); ++k) {
     const size_t entity = entities ? size_t((*entities)[k]) : k;
@@ -391,238 +166,204 @@ void Assembly::chainRows(const Effect& e, const Matrix& values, std::vector<size
       cols.push_back(col), vals.push_back(x);
     };
     for (size_t j = 0; j < dofs.extent(1); ++j) {
-      const int d = dofs(entity, j), c = coreOfNode_[d / 3];
-      if (c < 0) {
-        if (supportOf[d] < 0) add(gid(d), v(k, j));
+      const int d = dofs(entity, j);
+      if (!cores_.follows(d)) {
+        if (!constraints_.held(d)) add(gid(d), v(k, j));
         continue;
       }
-      // The core's free unknowns this dof moves with: its own translation
-      // component and the rotation (kept even where du/dtheta is 0, so that
-      // every evaluation has the same columns).
-      const RigidCore& core = cores_[c];
-      const auto B = coreChain(d);
-      for (int q = 0; q < 4; ++q)
-        if (core.free[q] && (q == 3 || q == d % 3)) add(gid(core.firstDof + q), v(k, j) * B[q]);
+      cores_.forEachFreeUnknown(d, [&](int coreDof, double B) { add(gid(coreDof), v(k, j) * B); });
     }
     rowStart.push_back(cols.size());
   }
 }
 
-LO Assembly::overlapLid(int dof) const {
-  const int ownedNodeDofs = int(3 * mesh_.numOwnedNodes);
-  if (dof >= nodeDofs_) return LO(coresOwned_ ? ownedNodeDofs + (dof - nodeDofs_) : dof);
-  return LO(coresOwned_ && dof >= ownedNodeDofs ? dof + int(6 * cores_.size()) : dof);
-}
-
 void Assembly::buildDofMaps() {
-  coresOwned_ = !cores_.empty() && mesh_.comm->getRank() == 0;
   if (cores_.empty()) {
     ownedDofMap_ = mesh_.ownedDofMap, overlapDofMap_ = mesh_.overlapDofMap;
     return;
   }
+  const int nodeDofs = layout_.nodeDofs;
   const GO firstCoreGid = GO(3 * mesh_.numGlobalNodes);
-  auto gid = [&](int d) { return d < nodeDofs_ ? 3 * mesh_.nodeGids[d / 3] + d % 3 : firstCoreGid + (d - nodeDofs_); };
-  const int ndof = int(constraints_.supportOf.size());
+  auto gid = [&](int d) { return d < nodeDofs ? 3 * mesh_.nodeGids[d / 3] + d % 3 : firstCoreGid + (d - nodeDofs); };
+  const int ndof = layout_.size();
   std::vector<GO> owned, overlap(ndof);
   for (int d = 0; d < int(3 * mesh_.numOwnedNodes); ++d) owned.push_back(gid(d));
-  if (coresOwned_)
-    for (int d = nodeDofs_; d < ndof; ++d) owned.push_back(gid(d));
-  for (int d = 0; d < ndof; ++d) overlap[overlapLid(d)] = gid(d);
+  if (layout_.coresOwned)
+    for (int d = nodeDofs; d < ndof; ++d) owned.push_back(gid(d));
+  for (int d = 0; d < ndof; ++d) overlap[layout_.overlapLid(d)] = gid(d);
   const auto invalid = Teuchos::OrdinalTraits<Tpetra::global_size_t>::invalid();
   ownedDofMap_ = rcp(new Map(invalid, Teuchos::ArrayView<const GO>(owned), 0, mesh_.comm));
   overlapDofMap_ = rcp(new Map(invalid, Teuchos::ArrayView<const GO>(overlap), 0, mesh_.comm));
 }
 
-void Assembly::readCores(const Teuchos::ArrayRCP<const double>& ud) {
-  for (auto& core : cores_) {
-    for (int i = 0; i < 3; ++i) core.translation[i] = ud[overlapLid(core.firstDof + i)];
-    core.rotation = ud[overlapLid(core.firstDof + 3)];
-  }
-  followers_.resize(mesh_.numOverlapNodes());
-  for (size_t n = 0; n < coreOfNode_.size(); ++n) {
-    if (coreOfNode_[n] < 0) continue;
-    const auto& core = cores_[coreOfNode_[n]];
-    followers_[n] = kernels::coreFollower(core.axisPoint.data(), core.axisDirection.data(), core.translation.data(),
-                                          core.rotation, &mesh_.X[3 * n]);
-  }
-}
-
-std::vector<std::array<double, 5>> Assembly::coreSums(const Teuchos::ArrayRCP<const double>& v) const {
-  const size_t nc = cores_.size();
-  std::vector<double> local(5 * nc, 0.0), global(5 * nc, 0.0);
-  for (size_t n = 0; n < mesh_.numOwnedNodes; ++n) {
-    const int c = coreOfNode_[n];
-    if (c < 0) continue;
-    for (int i = 0; i < 3; ++i) {
-      const double r = v[3 * n + i];
-      local[5 * c + i] += r;
-      local[5 * c + 3] += r * followers_[n].b[i];
-      local[5 * c + 4] += r * followers_[n].w[i];
-    }
-  }
-  if (nc) Teuchos::reduceAll(*mesh_.comm, Teuchos::REDUCE_SUM, int(5 * nc), local.data(), global.data());
-  std::vector<std::array<double, 5>> out(nc);
-  for (size_t c = 0; c < nc; ++c)
-    for (int k = 0; k < 5; ++k) out[c][k] = global[5 * c + k];
-  return out;
-}
-
 void Assembly::rollWithCores(Vector& u, const std::vector<double>& dTheta) {
   uOverlap_->doImport(u, *importer_, Tpetra::INSERT);
-  readCores(uOverlap_->getData());
-  auto data = u.getDataNonConst();
-  for (size_t c = 0; c < cores_.size(); ++c) {
-    const auto& core = cores_[c];
-    if (!core.free[3] || dTheta[c] == 0) continue;
-    for (size_t n = 0; n < mesh_.numOwnedNodes; ++n) {
-      double r[3], turned[3];
-      for (int i = 0; i < 3; ++i)
-        r[i] = mesh_.X[3 * n + i] + data[3 * n + i] - core.axisPoint[i] - core.translation[i];
-      kernels::rotateAboutAxis(core.axisDirection.data(), dTheta[c], r, turned);
-      for (int i = 0; i < 3; ++i) data[3 * n + i] += turned[i] - r[i];
-    }
-    if (coresOwned_) data[3 * mesh_.numOwnedNodes + 6 * c + 3] += dTheta[c];
-  }
+  cores_.read(uOverlap_->getData());
+  cores_.roll(u.getDataNonConst(), dTheta);
 }
 
 void Assembly::applyConstraints(Vector& u, double t) {
-  const auto& supportOf = constraints_.supportOf;
-  {
-    auto data = u.getDataNonConst();
-    for (LO d = 0; d < LO(data.size()); ++d) {
-      const int a = assemblyDof(d);
-      const bool follows = a < nodeDofs_ && coreOfNode_[a / 3] >= 0;
-      if (supportOf[a] >= 0 && !follows) data[d] = constraints_.velocity[a] * t;
-    }
-  }
+  constraints_.apply(u, t, cores_);
   if (cores_.empty()) return;
   // The face nodes follow the cores' values, which rank 0 owns.
   uOverlap_->doImport(u, *importer_, Tpetra::INSERT);
-  readCores(uOverlap_->getData());
-  auto data = u.getDataNonConst();
-  for (size_t n = 0; n < mesh_.numOwnedNodes; ++n)
-    if (coreOfNode_[n] >= 0)
-      for (int i = 0; i < 3; ++i) data[3 * n + i] = followers_[n].u[i];
+  cores_.read(uOverlap_->getData());
+  cores_.placeFaceNodes(u.getDataNonConst());
 }
 
 bool Assembly::evaluate(const Vector& u, Vector* f, FEMatrix* W, const Vector* z, Vector* Kz) {
-  Kokkos::Timer timer;
-  uOverlap_->doImport(u, *importer_, Tpetra::INSERT);
-  {
-    auto ud = uOverlap_->getData();
-    readCores(ud);
-    auto hx = Kokkos::create_mirror_view(x_);
-    auto hu = Kokkos::create_mirror_view(u_);
-    for (size_t n = 0; n < mesh_.numOverlapNodes(); ++n)
-      for (int i = 0; i < 3; ++i) {
-        // A core's face node sits where the core puts it, whatever u holds there.
-        hu(n, i) = coreOfNode_[n] >= 0 ? followers_[n].u[i] : ud[overlapLid(int(3 * n + i))];
-        hx(n, i) = mesh_.X[3 * n + i] + hu(n, i);
-      }
-    Kokkos::deep_copy(x_, hx);
-    Kokkos::deep_copy(u_, hu);
-  }
-  // The tangent goes straight from each kernel into W's local CRS values
-  // (and into K z for the predictor), entity by entity.
   if (bool(z) != bool(Kz) || (z && !W)) throw std::logic_error("assembly: K z needs z, Kz and the tangent W");
-  const bool action = z != nullptr;
+  Kokkos::Timer timer;
+  auto phase = [&](double& seconds, double& since) {
+    const double now = timer.seconds();
+    seconds += now - since;
+    since = now;
+  };
+  // Each phase writes its own rows of f and K z (node rows, held rows, the
+  // cores' rows); W is exported last, after every phase has added to it.
+  double since = 0;
+  importState(u, z);
+  phase(phases_.import, since);
   std::vector<Matrix> KzLocal;  // per effect: K z per entity (the sinks hold z per entity)
+  const bool valid = launchEffects(W, z, KzLocal);
+  phase(phases_.launch, since);
+  scatterResiduals(f, W, Kz, KzLocal);
+  phase(phases_.scatter, since);
+  constrainRows(f, W);
+  phase(phases_.constraints, since);
+  coupleCores(f, W, Kz);
+  phase(phases_.coreCoupling, since);
+  if (W) W->endAssembly();
+  phase(phases_.matrixExport, since);
+  if (f && !valid) {
+    // An inverted element: a residual Newton cannot mistake for converged.
+    auto out = f->getDataNonConst();
+    for (LO d = 0; d < LO(out.size()); ++d) out[d] = 1e150;
+  }
+  assemblySeconds_ += timer.seconds();
+  return valid;
+}
+
+// u (and z) on the overlapped dofs; the cores' q; the nodes' x and u.
+void Assembly::importState(const Vector& u, const Vector* z) {
+  uOverlap_->doImport(u, *importer_, Tpetra::INSERT);
+  auto ud = uOverlap_->getData();
+  cores_.read(ud);
+  auto hx = Kokkos::create_mirror_view(x_);
+  auto hu = Kokkos::create_mirror_view(u_);
+  for (size_t n = 0; n < mesh_.numOverlapNodes(); ++n)
+    for (int i = 0; i < 3; ++i) {
+      // A core's face node sits where the core puts it, whatever u holds there.
+      hu(n, i) = cores_.coreOf(n) >= 0 ? cores_.follower(n).u[i] : ud[layout_.overlapLid(int(3 * n + i))];
+      hx(n, i) = mesh_.X[3 * n + i] + hu(n, i);
+    }
+  Kokkos::deep_copy(x_, hx);
+  Kokkos::deep_copy(u_, hu);
+  if (z) {
+    if (zOverlap_.is_null()) zOverlap_ = rcp(new Vector(overlapDofMap_));
+    zOverlap_->doImport(*z, *importer_, Tpetra::INSERT);
+  }
+}
+
+// Every effect's kernel. The tangent goes straight from each kernel into W's
+// local CRS values (and into K z for the predictor), entity by entity. Returns
+// whether every element has det F > 0 (global).
+bool Assembly::launchEffects(FEMatrix* W, const Vector* z, std::vector<Matrix>& KzLocal) {
   if (W) {
     W->beginAssembly();
     W->setAllToScalar(0.0);
     const auto values = W->getLocalMatrixDevice().values;
-    for (size_t i = 0; i < effects_.size(); ++i)
-      if (effects_[i]->local().stiff) sinks_[i].values = values;  // the others evaluate without a sink
+    for (size_t i = 0; i < effects_.all.size(); ++i)
+      if (effects_.all[i]->local().stiff) sinks_[i].values = values;  // the others evaluate without a sink
   }
-  if (action) {
-    if (zOverlap_.is_null()) zOverlap_ = rcp(new Vector(overlapDofMap_));
-    zOverlap_->doImport(*z, *importer_, Tpetra::INSERT);
+  if (z) {
     auto zd = zOverlap_->getData();
-    for (size_t i = 0; i < effects_.size(); ++i) {
-      const auto& L = effects_[i]->local();
+    for (size_t i = 0; i < effects_.all.size(); ++i) {
+      const auto& L = effects_.all[i]->local();
       KzLocal.emplace_back("K z", L.dofs.extent(0), L.dofs.extent(1));  // zero for entities without a tangent
       if (!L.stiff) continue;
       auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.dofs);
       Matrix zLocal("z", dofs.extent(0), dofs.extent(1));
       auto hz = Kokkos::create_mirror_view(zLocal);
       for (size_t e = 0; e < dofs.extent(0); ++e)
-        for (size_t k = 0; k < dofs.extent(1); ++k) hz(e, k) = zd[overlapLid(dofs(e, k))];
+        for (size_t k = 0; k < dofs.extent(1); ++k) hz(e, k) = zd[layout_.overlapLid(dofs(e, k))];
       Kokkos::deep_copy(zLocal, hz);
       sinks_[i].z = zLocal, sinks_[i].Kz = KzLocal.back();
     }
   }
-  for (size_t i = 0; i < effects_.size(); ++i)
-    effects_[i]->evaluate(x_, u_, W && effects_[i]->local().stiff ? &sinks_[i] : nullptr);
+  for (size_t i = 0; i < effects_.all.size(); ++i)
+    effects_.all[i]->evaluate(x_, u_, W && effects_.all[i]->local().stiff ? &sinks_[i] : nullptr);
   for (auto& sink : sinks_) sink.values = {}, sink.z = {}, sink.Kz = {};  // no stale views kept
 
   double minJ = 1e300;
-  auto elementMinJ = bricks_->minJacobian;
+  auto elementMinJ = effects_.bricks->minJacobian;
   Kokkos::parallel_reduce(
       "min J", Kokkos::RangePolicy<ExecSpace>(0, elementMinJ.extent(0)),
       KOKKOS_LAMBDA(int e, double& m) { m = elementMinJ(e) < m ? elementMinJ(e) : m; },
       Kokkos::Min<double>(minJ));
   double globalMinJ = minJ;
   Teuchos::reduceAll(*mesh_.comm, Teuchos::REDUCE_MIN, minJ, Teuchos::outArg(globalMinJ));
-  const bool valid = globalMinJ > 0 && std::isfinite(globalMinJ);
-  const auto& supportOf = constraints_.supportOf;
+  return globalMinJ > 0 && std::isfinite(globalMinJ);
+}
 
-  // The residual; with rigid cores also for the tangent alone, whose
-  // theta-theta entry needs the reactions at the face nodes.
+// The per-entity residuals summed into the owned rows, kept unconstrained for
+// the reactions and the cores' sums, and copied to f's node rows; likewise K z.
+// With rigid cores the residual is also needed for the tangent alone, whose
+// theta-theta entry needs the reactions at the face nodes.
+void Assembly::scatterResiduals(Vector* f, FEMatrix* W, Vector* Kz, const std::vector<Matrix>& KzLocal) {
   if (f || (W && !cores_.empty())) {
     std::vector<Matrix> R;
-    for (const auto& effect : effects_) R.push_back(effect->local().R);
+    for (const auto& effect : effects_.all) R.push_back(effect->local().R);
     sumEntityVectors(R);
     auto ro = residual_->getData(0);
     rawOwnedResidual_.assign(ro.begin(), ro.end());
-    const auto sums = coreSums(ro);
-    for (size_t c = 0; c < cores_.size(); ++c) {
-      for (int i = 0; i < 3; ++i) cores_[c].forceOnBody[i] = sums[c][i];
-      cores_[c].torqueOnBody = sums[c][3];
-      cores_[c].geometric = sums[c][4];
-    }
     if (f) {
       auto out = f->getDataNonConst();
-      for (LO d = 0; d < LO(out.size()); ++d) {
-        const int a = assemblyDof(d);
-        if (!valid) out[d] = 1e150;
-        else if (supportOf[a] >= 0) out[d] = 0.0;
-        else if (a < nodeDofs_) out[d] = ro[d];
-        else {
-          // A core's free unknown: the reactions it exerts on the body balance
-          // the external load on it.
-          const auto& core = cores_[(a - nodeDofs_) / 6];
-          const int j = (a - nodeDofs_) % 6;
-          const double load = core.loadFactor(time_);
-          out[d] = j < 3 ? core.forceOnBody[j] - load * core.force[j] : core.torqueOnBody - load * core.torque;
-        }
-      }
+      for (LO d = 0; d < LO(out.size()); ++d)
+        if (layout_.assemblyDof(d) < layout_.nodeDofs) out[d] = ro[d];
     }
   }
-
-  if (action) {
-    // K z: summed like a residual, then carried to the cores' unknowns.
+  if (Kz) {
+    // K z: summed like a residual (its cores' rows: coupleCores).
     sumEntityVectors(KzLocal);
     auto ro = residual_->getData(0);
-    const auto sums = coreSums(ro);
     auto yd = Kz->getDataNonConst();
-    for (LO d = 0; d < LO(yd.size()); ++d) {
-      const int a = assemblyDof(d);
-      yd[d] = a < nodeDofs_ ? ro[d] : (a - nodeDofs_) % 6 < 4 ? sums[(a - nodeDofs_) / 6][(a - nodeDofs_) % 6] : 0.0;
+    for (LO d = 0; d < LO(yd.size()); ++d)
+      if (layout_.assemblyDof(d) < layout_.nodeDofs) yd[d] = ro[d];
+  }
+}
+
+// Held rows: f = 0 there, and W has the identity in row and column (the
+// kernels left the held rows and columns out).
+void Assembly::constrainRows(Vector* f, FEMatrix* W) {
+  if (f) {
+    auto out = f->getDataNonConst();
+    for (LO d = 0; d < LO(out.size()); ++d)
+      if (constraints_.held(layout_.assemblyDof(d))) out[d] = 0.0;
+  }
+  if (W) constraints_.setDiagonal(*W);
+}
+
+// The cores' part: the reactions at their face nodes, f's rows of their free
+// unknowns, K z carried to their unknowns, and the chain rule in W.
+void Assembly::coupleCores(Vector* f, FEMatrix* W, Vector* Kz) {
+  if (f || (W && !cores_.empty())) cores_.setReactions(rawOwnedResidual_.data());
+  if (f) {
+    auto out = f->getDataNonConst();
+    for (LO d = 0; d < LO(out.size()); ++d) {
+      const int a = layout_.assemblyDof(d);
+      if (a >= layout_.nodeDofs && !constraints_.held(a)) out[d] = cores_.residual(a, time_);
     }
   }
-
-  if (W) {
-    const auto values = W->getLocalMatrixDevice().values;
-    const auto diagonal = constrainedDiagonal_;
-    Kokkos::parallel_for(
-        "constrained diagonal", Kokkos::RangePolicy<ExecSpace>(0, diagonal.extent(0)),
-        KOKKOS_LAMBDA(int j) { values(diagonal(j)) = 1.0; });
-    Kokkos::fence();
-    assembleCoreCoupling(*W);
-    W->endAssembly();
+  if (Kz) {
+    auto yd = Kz->getDataNonConst();
+    const auto sums = cores_.sums(yd.getRawPtr());  // over the node rows (K z's owned sums)
+    for (LO d = 0; d < LO(yd.size()); ++d) {
+      const int a = layout_.assemblyDof(d) - layout_.nodeDofs;
+      if (a >= 0) yd[d] = a % 6 < 4 ? sums[a / 6][a % 6] : 0.0;
+    }
   }
-  assemblySeconds_ += timer.seconds();
-  return valid;
+  if (W) cores_.assembleCoupling(*W, effects_.all, sinks_, columnOf_, constraints_);
 }
 
 void Assembly::sumEntityVectors(const std::vector<Matrix>& values) {
@@ -630,49 +371,24 @@ void Assembly::sumEntityVectors(const std::vector<Matrix>& values) {
   residual_->putScalar(0.0);
   {
     auto r = residual_->getDataNonConst(0);
-    for (size_t i = 0; i < effects_.size(); ++i) {
-      auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), effects_[i]->local().dofs);
+    for (size_t i = 0; i < effects_.all.size(); ++i) {
+      auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), effects_.all[i]->local().dofs);
       auto v = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), values[i]);
-      auto active = activeOnHost(effects_[i]->local());
+      auto active = activeOnHost(effects_.all[i]->local());
       for (size_t e = 0; e < dofs.extent(0); ++e)
         if (!active.size() || active(e))
-          for (size_t k = 0; k < dofs.extent(1); ++k) r[overlapLid(dofs(e, k))] += v(e, k);
+          for (size_t k = 0; k < dofs.extent(1); ++k) r[layout_.overlapLid(dofs(e, k))] += v(e, k);
     }
   }
   residual_->endAssembly();  // one export: shared rows added into their owners
 }
 
 void Assembly::constraintIncrement(Vector& z, double t0, double t1) const {
-  auto data = z.getDataNonConst();
-  const auto& supportOf = constraints_.supportOf;
-  const auto& velocity = constraints_.velocity;
-  for (LO d = 0; d < LO(data.size()); ++d) {
-    const int a = assemblyDof(d);
-    if (a < nodeDofs_ && coreOfNode_[a / 3] >= 0) {
-      // Linearised at the cores' last state: dT + b dtheta, held parts only.
-      const auto& core = cores_[coreOfNode_[a / 3]];
-      const int i = a % 3;
-      const double dT = supportOf[core.firstDof + i] >= 0 ? velocity[core.firstDof + i] * (t1 - t0) : 0.0;
-      const double dTheta = supportOf[core.firstDof + 3] >= 0 ? velocity[core.firstDof + 3] * (t1 - t0) : 0.0;
-      data[d] = dT + followers_[a / 3].b[i] * dTheta;
-    } else {
-      data[d] = supportOf[a] >= 0 ? velocity[a] * (t1 - t0) : 0.0;
-    }
-  }
+  constraints_.increment(z, t0, t1, cores_);
 }
 
 std::vector<std::array<double, 3>> Assembly::constraintReactions() const {
-  const size_t ns = constraints_.supportNames.size();
-  std::vector<double> local(3 * ns, 0.0), global(3 * ns, 0.0);
-  for (size_t d = 0; d < rawOwnedResidual_.size(); ++d) {
-    const int a = assemblyDof(LO(d));
-    if (constraints_.supportOf[a] >= 0) local[3 * constraints_.supportOf[a] + a % 3] += rawOwnedResidual_[d];
-  }
-  if (ns)
-    Teuchos::reduceAll(*mesh_.comm, Teuchos::REDUCE_SUM, int(3 * ns), local.data(), global.data());
-  std::vector<std::array<double, 3>> out(ns);
-  for (size_t s = 0; s < ns; ++s) out[s] = {global[3 * s], global[3 * s + 1], global[3 * s + 2]};
-  return out;
+  return constraints_.reactions(rawOwnedResidual_, *mesh_.comm);
 }
 
 }  // namespace capstan

@@ -21,7 +21,7 @@ namespace capstan::checkpoint {
 
 namespace fs = std::filesystem;
 
-inline const char* kMagic = "capstan checkpoint 2";
+inline const char* kMagic = "capstan checkpoint 3";
 
 class Writer {
  public:

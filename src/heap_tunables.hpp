@@ -5,15 +5,12 @@
 // pages" and "Page faults"):
 // - glibc.malloc.hugetlb=1: the heap in transparent huge pages. A TLB miss
 //   costs a nested page walk there, and one assembly streams through every
-//   element matrix, its CRS offsets and the matrix values. G1 4x ran 1.45x
-//   faster on 1 rank, G1 8x 1.31x on 2, for under 2% more memory.
+//   element matrix, its CRS offsets and the matrix values.
 // - glibc.malloc.mmap_max=0 and a trim threshold of 64 GiB: freed memory stays
 //   with the process. By default glibc gives every block above 32 MiB its own
 //   mapping and unmaps it when freed. Each Krylov solve allocates its GMRES
-//   basis anew (201 vectors: 440 MiB per rank on G1 8x, 2 ranks) and each
-//   MueLu set-up its matrices, so the kernel zeroed fresh pages over and over,
-//   at about 1 GB/s here. G1 8x's first load step ran 1.1x faster on 1 rank
-//   and 1.3x on 2, for 2-4% more peak memory.
+//   basis anew and each MueLu set-up its matrices, so the kernel zeroed fresh
+//   pages over and over, at about 1 GB/s here.
 //
 // How: glibc reads GLIBC_TUNABLES only when a program starts, so the program
 // runs itself again, once, with the settings added. A setting the user's

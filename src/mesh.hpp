@@ -41,15 +41,13 @@ class MeshGenerator {
 //   it (a box's z, an annulus's axis). Each rank's nodes are then a run of
 //   the one-rank numbering, and MueLu's aggregation, which walks the nodes in
 //   that order, makes nearly the aggregates it makes on one rank
-//   (docs/performance.md, "Page faults and partitions").
+//   (docs/performance.md, "Partitions").
 enum class Partition { Metis, Slabs };
 
 // Mesh/Partition = Auto: Slabs on several ranks where each rank's slab is at
 // least kAutoSlabLayers cells thick along the slowest index, METIS otherwise.
-// Measured on 2 ranks (docs/performance.md, "The 2-rank speed-up in rounds"):
-// G1 8x, 24 layers a slab, slabs took 282.8 s on the mean of seven rounds
-// against METIS's 328.9 s; H1 8x, 4 layers, slabs were slower (67.4 s against
-// 63.9 s); G1 4x, 12 layers, the same Krylov iterations (1,001 against 1,007).
+// Thick slabs keep MueLu's aggregates as on one rank; thin ones leave the
+// ranks unequal (docs/performance.md, "Defaults and why" and "Partitions").
 constexpr int kAutoSlabLayers = 16;
 Partition autoPartition(int slowestCells, int ranks);
 // Mesh/Partition's value: "METIS", "Slabs", or "Auto" (autoPartition), and back;

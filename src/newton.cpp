@@ -259,41 +259,42 @@ RCP<Tpetra::MultiVector<>> rigidBodyModes(const Assembly& assembly) {
 
 // capstan's solver knobs as Stratimikos parameters; the scene's Solver/Stratimikos
 // sublist is applied over them.
-Teuchos::ParameterList stratimikosParameters(const Teuchos::ParameterList& solver, long dofs, int ranks,
+Teuchos::ParameterList stratimikosParameters(const SolverSettings& solver, long dofs, int ranks,
                                              const RCP<Tpetra::MultiVector<>>& nullspace,
                                              const RCP<Tpetra::MultiVector<>>& coordinates) {
   Teuchos::ParameterList p("Stratimikos");
-  std::string method = solver.get<std::string>("Linear Solver");
+  using S = SolverSettings;
+  S::LinearSolver method = solver.linearSolver;
   // Auto: a sparse direct solve is fastest and immune to the penalty's
   // conditioning on small meshes; Krylov with ILU above that size.
-  if (method == "Auto") method = dofs <= solver.get<int>("Direct Solver Max Dofs") ? "Direct" : "GMRES";
+  if (method == S::LinearSolver::Auto)
+    method = dofs <= solver.directSolverMaxDofs ? S::LinearSolver::Direct : S::LinearSolver::GMRES;
   // Amesos2's KLU2 on several ranks solves our matrices wrongly in Trilinos
   // 13.2 (Newton stalls: G1 and H1 ended with exit 2; first seen with a rigid
   // core's rows, docs/pinch-roller.md): GMRES there, whatever the scene asked.
-  if (method == "Direct" && ranks > 1) method = "GMRES";
-  if (method == "Direct") {
+  if (method == S::LinearSolver::Direct && ranks > 1) method = S::LinearSolver::GMRES;
+  if (method == S::LinearSolver::Direct) {
     p.set("Linear Solver Type", "Amesos2");
     p.set("Preconditioner Type", "None");
   } else {
     p.set("Linear Solver Type", "Belos");
     auto& belos = p.sublist("Linear Solver Types").sublist("Belos");
-    const std::string type = method == "CG" ? "Pseudo Block CG" : "Block GMRES";
+    const std::string type = method == S::LinearSolver::CG ? "Pseudo Block CG" : "Block GMRES";
     belos.set("Solver Type", type);
     auto& st = belos.sublist("Solver Types").sublist(type);
-    st.set("Convergence Tolerance", solver.get<double>("Linear Tolerance"));
-    st.set("Maximum Iterations", solver.get<int>("Max Linear Iterations"));
+    st.set("Convergence Tolerance", solver.linearTolerance);
+    st.set("Maximum Iterations", solver.maxLinearIterations);
     if (type == "Block GMRES") {
       st.set("Num Blocks", 200);
       st.set("Maximum Restarts", 20);
     }
-    std::string prec = solver.get<std::string>("Preconditioner");
-    // Auto: smoothed aggregation pays for its setup from about 1000 dofs on
-    // (G1, 1575 dofs: GMRES+MueLu 2.9 s, GMRES+ILU 6.5 s; 28x8x12, 10k dofs:
-    // 38 s vs 132 s); below, ILU is cheaper (H5, 378 dofs, 2 ranks: 1.5 s vs 3.5 s).
-    if (prec == "Auto") prec = dofs >= 1000 ? "MueLu" : "ILU";
-    if (prec == "None") {
+    S::Preconditioner prec = solver.preconditioner;
+    // Auto: smoothed aggregation pays for its setup from about 1000 dofs on;
+    // below, ILU is cheaper (docs/performance.md, "Defaults and why").
+    if (prec == S::Preconditioner::Auto) prec = dofs >= 1000 ? S::Preconditioner::MueLu : S::Preconditioner::ILU;
+    if (prec == S::Preconditioner::None) {
       p.set("Preconditioner Type", "None");
-    } else if (prec == "MueLu") {
+    } else if (prec == S::Preconditioner::MueLu) {
       // Smoothed aggregation with the rigid-body modes, Chebyshev smoothing.
       p.set("Preconditioner Type", "MueLu");
       auto& ml = p.sublist("Preconditioner Types").sublist("MueLu");
@@ -304,7 +305,7 @@ Teuchos::ParameterList stratimikosParameters(const Teuchos::ParameterList& solve
       // Solver/Stratimikos/Preconditioner Types/MueLu/smoother: type (then
       // that smoother's defaults: MueLu rejects a Chebyshev degree for it).
       std::string userSmoother = "CHEBYSHEV";
-      const auto& strat = solver.sublist("Stratimikos");
+      const auto& strat = solver.stratimikos;
       if (strat.isSublist("Preconditioner Types") && strat.sublist("Preconditioner Types").isSublist("MueLu")) {
         const auto& user = strat.sublist("Preconditioner Types").sublist("MueLu");
         if (user.isType<std::string>("smoother: type")) userSmoother = user.get<std::string>("smoother: type");
@@ -315,14 +316,13 @@ Teuchos::ParameterList stratimikosParameters(const Teuchos::ParameterList& solve
       }
       ml.set("coarse: max size", 1500);
       // Restriction applied as P^T instead of a stored R: the same iterations
-      // and time, 5% less memory (G1 4x: 654 against 690 MiB on 1 rank).
+      // and time, 5% less memory (docs/performance.md, "Defaults and why").
       ml.set("transpose: use implicit", true);
       ml.set("Nullspace", nullspace);
       // On several ranks the coarse levels (below 2000 unknowns per rank) move
       // onto one rank, so that the coarsest solve is a serial KLU2: Amesos2's
       // KLU2 on a distributed matrix solves wrongly in Trilinos 13.2, and a
-      // wrong coarse solve doubled MueLu's iterations (H1 4x without friction,
-      // 2 ranks: 450 Krylov iterations, 210 with this; 1 rank: 211).
+      // wrong coarse solve doubles MueLu's iterations (docs/performance.md).
       if (ranks > 1) {
         ml.set("repartition: enable", true);
         ml.set("repartition: partitioner", "zoltan2");
@@ -333,18 +333,18 @@ Teuchos::ParameterList stratimikosParameters(const Teuchos::ParameterList& solve
     } else {
       p.set("Preconditioner Type", "Ifpack2");
       auto& ifp = p.sublist("Preconditioner Types").sublist("Ifpack2");
-      if (prec == "ILU") {
+      if (prec == S::Preconditioner::ILU) {
         // ILU(k) of each rank's diagonal block (Ifpack2 filters out the
         // off-rank columns itself): block Jacobi between ranks.
         ifp.set("Prec Type", "RILUK");
-        ifp.sublist("Ifpack2 Settings").set("fact: iluk level-of-fill", solver.get<int>("ILU Level"));
+        ifp.sublist("Ifpack2 Settings").set("fact: iluk level-of-fill", solver.iluLevel);
       } else {
         ifp.set("Prec Type", "RELAXATION");
         ifp.sublist("Ifpack2 Settings").set("relaxation: type", "Jacobi");
       }
     }
   }
-  p.setParameters(solver.sublist("Stratimikos"));
+  p.setParameters(solver.stratimikos);
   return p;
 }
 
@@ -352,7 +352,7 @@ Teuchos::ParameterList stratimikosParameters(const Teuchos::ParameterList& solve
 
 struct NewtonSolver::Impl {
   Assembly& assembly;
-  Teuchos::ParameterList solver;
+  SolverSettings solver;
   Teuchos::ParameterList strat;
   RCP<Thyra::LinearOpWithSolveFactoryBase<double>> lows;
   RCP<BodyModel> model;
@@ -364,14 +364,13 @@ struct NewtonSolver::Impl {
   std::unique_ptr<LagPolicy> lag;
   double linearSeconds = 0;
   double preconditionerSeconds = 0;  // part of linearSeconds
-  Impl(Assembly& a, const Teuchos::ParameterList& s) : assembly(a), solver(s) {}
+  Impl(Assembly& a, const SolverSettings& s) : assembly(a), solver(s) {}
 
   RCP<Teuchos::ParameterList> noxParameters(const RCP<NOX::Observer>& observer) const {
     auto params = Teuchos::parameterList("NOX");
     params->set("Nonlinear Solver", "Line Search Based");
-    const std::string ls = solver.get<std::string>("Line Search");
     auto& lsp = params->sublist("Line Search");
-    lsp.set("Method", ls);
+    lsp.set("Method", std::string(nameOf(solver.lineSearch, SolverSettings::lineSearches)));
     // Backtrack (the default) halves the step until 0.5 |R|^2 decreases. An
     // evaluation that inverts an element (det F <= 0 at a Gauss point) returns
     // |R| = 1e150 per dof (Assembly::evaluate), so the line search backs off
@@ -384,39 +383,38 @@ struct NewtonSolver::Impl {
     // kink). A failed line search takes no step (Recovery Step 0): NOX's
     // default takes the full Newton step anyway, into inverted states where the
     // tangent is singular (the direct solver throws), and at round-off, where no
-    // step decreases |R|, it wanders until Stagnation stops it (H5: 70 Newton
-    // iterations instead of 42, same answer; tests/integration/line_search.py).
-    if (ls == "Backtrack") {
+    // step decreases |R|, it wanders until Stagnation stops it
+    // (tests/integration/line_search.py measures both).
+    if (solver.lineSearch == SolverSettings::LineSearch::Backtrack) {
       lsp.sublist("Backtrack").set("Max Iters", 20);
       lsp.sublist("Backtrack").set("Recovery Step", 0.0);
     }
     auto& newton = params->sublist("Direction").sublist("Newton");
-    newton.sublist("Linear Solver").set("Tolerance", solver.get<double>("Linear Tolerance"));
+    newton.sublist("Linear Solver").set("Tolerance", solver.linearTolerance);
     // Eisenstat-Walker (NOX's Type 2): far from the solution a Krylov solve to
     // 1e-10 is wasted work, since the next Newton step changes the system
     // anyway. Solving to eta_k ~ (|R_k|/|R_k-1|)^1.5 keeps Newton superlinear
-    // and cut G1's Krylov iterations 2.5x (docs/performance.md). The answer is
-    // the same: Newton still converges to its own tolerance.
-    if (solver.get<std::string>("Linear Tolerance Method") == "Adaptive") {
+    // and cuts the Krylov iterations 2.5x (docs/performance.md, "Defaults and
+    // why"). The answer is the same: Newton still converges to its own tolerance.
+    if (solver.linearToleranceMethod == SolverSettings::ToleranceMethod::Adaptive) {
       newton.set("Forcing Term Method", "Type 2");
-      newton.set("Forcing Term Minimum Tolerance", solver.get<double>("Linear Tolerance"));
-      // Never looser than 1e-3: NOX's default ceiling let H1 on 2 ranks (soft
-      // foundation, block-Jacobi ILU) crawl at 30 Newton iterations per step;
-      // with 1e-2 or 1e-3 it takes 22-25, and G1 costs the same either way.
+      newton.set("Forcing Term Minimum Tolerance", solver.linearTolerance);
+      // Never looser than 1e-3: with NOX's default ceiling a soft foundation
+      // under block-Jacobi ILU (H1 on 2 ranks) crawled at the iteration limit.
       newton.set("Forcing Term Maximum Tolerance",
-                 std::max(1e-3, solver.get<double>("Linear Tolerance")));
+                 std::max(1e-3, solver.linearTolerance));
     }
     params->sublist("Printing").set("Output Information", 0);
     // NOX writes some notes (e.g. "line search failed") to its output stream
     // whatever the print level; capstan reports the outcome itself.
     params->sublist("Printing").set<RCP<std::ostream>>("Output Stream", rcp(new Teuchos::oblackholestream));
     params->sublist("Solver Options").set<RCP<NOX::Observer>>("Observer", observer);
-    params->setParameters(solver.sublist("NOX"));
+    params->setParameters(solver.nox);
     return params;
   }
 };
 
-NewtonSolver::NewtonSolver(Assembly& assembly, const Teuchos::ParameterList& solver)
+NewtonSolver::NewtonSolver(Assembly& assembly, const SolverSettings& solver)
     : impl_(std::make_unique<Impl>(assembly, solver)) {
   Stratimikos::DefaultLinearSolverBuilder builder;
   using PrecBase = Thyra::PreconditionerFactoryBase<double>;
@@ -426,12 +424,12 @@ NewtonSolver::NewtonSolver(Assembly& assembly, const Teuchos::ParameterList& sol
   Stratimikos::enableMueLu(builder);
   const int ranks = assembly.dofMap()->getComm()->getSize();
   const bool rank0 = assembly.dofMap()->getComm()->getRank() == 0;
-  if (ranks > 1 && solver.get<std::string>("Linear Solver") == "Direct" && rank0)  // (stratimikosParameters)
+  if (ranks > 1 && solver.linearSolver == SolverSettings::LinearSolver::Direct && rank0)  // (stratimikosParameters)
     std::fprintf(stderr, "capstan: note: Solver/Linear Solver = Direct is not reliable on %d ranks "
                          "(Amesos2 KLU2 in Trilinos 13.2); using GMRES\n", ranks);
   impl_->strat = stratimikosParameters(solver, long(assembly.dofMap()->getGlobalNumElements()), ranks,
-                                       solver.get<std::string>("Preconditioner") != "ILU" &&
-                                               solver.get<std::string>("Preconditioner") != "Jacobi"
+                                       solver.preconditioner != SolverSettings::Preconditioner::ILU &&
+                                               solver.preconditioner != SolverSettings::Preconditioner::Jacobi
                                            ? rigidBodyModes(assembly)
                                            : Teuchos::null,
                                        ranks > 1 ? unknownCoordinates(assembly) : Teuchos::null);
@@ -447,11 +445,11 @@ NewtonSolver::NewtonSolver(Assembly& assembly, const Teuchos::ParameterList& sol
       // Newton's may be kept across iterations (Solver/Preconditioner Reuse).
       impl_->lows->setPreconditionerFactory(
           rcp(new TimedPreconditionerFactory(prec, impl_->preconditionerSeconds, false)), "timed");
-      const bool lagged = solver.get<std::string>("Preconditioner Reuse") == "Adaptive";
+      const bool lagged = solver.preconditionerReuse == SolverSettings::Reuse::Adaptive;
       impl_->newtonPrecFactory = rcp(new TimedPreconditionerFactory(prec, impl_->preconditionerSeconds, lagged));
       impl_->prec = impl_->newtonPrecFactory->createPrec();
       if (lagged)
-        impl_->lag = std::make_unique<LagPolicy>(*impl_->newtonPrecFactory, solver.get<int>("Max Linear Iterations"),
+        impl_->lag = std::make_unique<LagPolicy>(*impl_->newtonPrecFactory, solver.maxLinearIterations,
                                                  2.0, 10);
     }
   } catch (const std::exception& e) {
@@ -463,7 +461,7 @@ NewtonSolver::NewtonSolver(Assembly& assembly, const Teuchos::ParameterList& sol
   // built. A scene that passes its own (Solver/Stratimikos/Preconditioner
   // Types) gets one built now, on the tangent at the undeformed state, so that
   // a bad name or value stops the run before anything is written.
-  const auto& strat = solver.sublist("Stratimikos");
+  const auto& strat = solver.stratimikos;
   if (!impl_->newtonPrecFactory.is_null() && strat.isSublist("Preconditioner Types")) {
     try {
       Vector zero(assembly.dofMap());
@@ -579,7 +577,7 @@ NewtonResult NewtonSolver::solve(Vector& u, double tolerance) {
   auto params = impl_->noxParameters(history);
 
   auto normF = rcp(new NOX::StatusTest::NormF(tolerance));
-  auto maxIters = rcp(new NOX::StatusTest::MaxIters(impl_->solver.get<int>("Max Newton Iterations")));
+  auto maxIters = rcp(new NOX::StatusTest::MaxIters(impl_->solver.maxNewtonIterations));
   auto finite = rcp(new NOX::StatusTest::FiniteValue);
   auto stagnation = rcp(new NOX::StatusTest::Stagnation(5, 0.999));
   auto tests = rcp(new NOX::StatusTest::Combo(NOX::StatusTest::Combo::OR));

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "assembly.hpp"
+#include "solver_settings.hpp"
 
 namespace capstan {
 
@@ -25,8 +26,7 @@ struct NewtonResult {
 
 class NewtonSolver {
  public:
-  // solver: the scene's resolved Solver sublist.
-  NewtonSolver(Assembly& assembly, const Teuchos::ParameterList& solver);
+  NewtonSolver(Assembly& assembly, const SolverSettings& solver);
   ~NewtonSolver();
   // Solves R(u) = 0 from the initial guess u (updated in place) until
   // |R| <= tolerance.

@@ -10,13 +10,9 @@ namespace capstan {
 
 namespace {
 // S^-1 ~ (eps M)^-1 + kLaplacianWeight L^-1, L^-1 by kLaplacianIterations of
-// CG, chosen before the step's stop rule demanded the 1e-3 first (docs/performance.md):
-// G1 4x (30.6 s with the diagonal S) took 28.2 s at 0.15 and 30, 28.8 s at
-// 0.25, 31.7 s at 1 (more passes: the steps' larger pressure changes leave a
-// larger nonlinear remainder), 29.9 s at 15 or 50 iterations. An exact L^-1
-// (a direct solve) at 0.5 takes the last pass from 73 to 19 iterations; a MueLu
-// V-cycle for it instead makes the step slower than the diagonal alone (its
-// coarse levels do not hold the nearly spurious modes).
+// CG: the fastest weight and count measured on G1 4x; a larger weight leaves a
+// larger nonlinear remainder per pass (docs/performance.md, "Defaults and why"
+// and "The Laplacian's inverse").
 constexpr double kLaplacianWeight = 0.15;
 constexpr int kLaplacianIterations = 30;
 }  // namespace

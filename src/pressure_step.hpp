@@ -9,7 +9,7 @@
 // run on 1x, 2x, 4x, even with Anderson mixing), each a Newton solve. This
 // step instead solves for the position change dx and the multipliers' changes
 // dmu together, so that equilibrium holds and every constraint is met to first
-// order (effects.hpp, ConstraintRows: the element volumes, c_e = v_e - V_e with
+// order (effects/effect.hpp, ConstraintRows: the element volumes, c_e = v_e - V_e with
 // the anchors; exact contact's points in contact, c_q = g_q with lambda_q):
 //
 //     [ K     B F ] [dx ]   [ -R ]     K: Newton's tangent (the penalties)

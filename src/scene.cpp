@@ -20,6 +20,8 @@
 #include <sstream>
 
 #include "errors.hpp"
+#include "parameters.hpp"
+#include "vec3.hpp"
 
 namespace capstan {
 
@@ -87,26 +89,7 @@ ParameterList validParameters() {
             "of the run: b t / (Steps x Step Size). Zero: no body-force kernel runs");
 
   auto& sup = p.sublist("Supports", false, "Boundary supports, one sublist per support, any name");
-  auto& s = sup.sublist(kAnyName, false, "A support");
-  s.set("Face", std::string(""), "Name of the mesh face it acts on");
-  s.set("Type", std::string("Fixed"), "Fixed | Roller | Foundation | Displacement | Rigid Core");
-  s.set("Components", std::string("xyz"), "Roller, Foundation, Displacement: components acted on, e.g. \"y\" or \"xz\"");
-  s.set("Stiffness", 1.0, "Foundation: k > 0, traction -k (x - X) per reference area");
-  s.set("Velocity", vec3(0, 0, 0), "Displacement: u = Velocity * t on the listed components");
-  s.set("Axis Point", vec3(0, 0, 0), "Rigid Core: a point of the core's axis");
-  s.set("Axis Direction", vec3(0, 0, 1), "Rigid Core: the axis it turns about (right-hand rule, non-zero)");
-  s.set("Free Translation", std::string(""),
-        "Rigid Core: the components it may translate along, e.g. \"y\"; \"\" holds all");
-  s.set("Force", vec3(0, 0, 0),
-        "Rigid Core: external force on the core (a spring's preload), only along free components");
-  s.set("Force Ramp Time", 0.0,
-        "Rigid Core: Force and Torque grow linearly from 0 and are reached at this time (> 0), then "
-        "held; 0 = the first step's end");
-  s.set("Rotation", std::string("Fixed"), "Rigid Core: Fixed | Free | Prescribed (about the axis)");
-  s.set("Torque", 0.0,
-        "Rigid Core, Rotation = Free: external torque on the core about its axis (right-hand rule; "
-        "a brake acts against the rotation), ramped like Force");
-  s.set("Angular Velocity", 0.0, "Rigid Core, Rotation = Prescribed: rad per unit time, right-hand rule");
+  SupportSpec::declare(sup.sublist(kAnyName, false, "A support"));
 
   auto& caps = p.sublist("Capstans", false, "Rigid cylinders (formulation.md §2), one sublist each, any name");
   auto& c = caps.sublist(kAnyName, false, "A capstan");
@@ -116,94 +99,14 @@ ParameterList validParameters() {
   c.set("Velocity", vec3(0, 0, 0), "Translation of the axis per unit time");
   c.set("Angular Velocity", 0.0, "Spin about the axis, rad per unit time, right-hand rule");
   c.set("Contact Faces", std::string(""), "Candidate contact faces, names separated by spaces or commas");
-  auto& contact = c.sublist("Contact", false, "Normal contact");
-  contact.set("Method", std::string("Penalty"), "Penalty | Augmented Lagrangian");
-  contact.set("Penalty", 1e-3, "eps2 > 0: penetration per unit contact pressure");
-  contact.set("Penetration Tolerance", 0.0,
-              "Multiplier loop (augmented Lagrangian, or a penalty solved at a larger penalty): "
-              "stop when the penetration (or its error against the penalty answer) is below "
-              "this; 0 = 1e-4 x the smallest candidate face edge");
-  contact.set("Max Augmentations", 50, "Augmented Lagrangian: most multiplier updates per step");
-  contact.set("Minimum Solve Penalty", -1.0,
-              "Newton solves use eps = max(Penalty, this), and multiplier updates then reach the "
-              "answer of Penalty (or exact contact): a well-conditioned solve for any Penalty. "
-              "< 0: automatic, 1e-2 h / c with the Nodal rule (h the smallest candidate face edge), "
-              "off with Gauss rules; 0: off");
-  contact.set("Quadrature", std::string("Auto"),
-              "Contact points per face: Auto | Gauss 2x2 | Gauss 3x3 | Nodal (at the face's nodes). "
-              "Auto: Gauss 2x2 for Penalty, Nodal for Augmented Lagrangian (exact contact at every "
-              "Gauss point of flat faces on a curved capstan over-constrains the body)");
-  contact.set("Smoothing", 0.0,
-              "Pressure scale eta >= 0 of a smoothed contact law: t_n = (tn + sqrt(tn^2 + eta^2)) / 2 "
-              "instead of max(0, tn), at most eta/2 different. Removes the corner where points enter "
-              "and leave contact, at which Newton stalls in rolling contact; 0 = the exact max");
-  auto& fr = c.sublist("Friction", false, "Friction between body and capstan (formulation.md §3)");
-  fr.set("Law", std::string("None"), "None | Tanh | Arctan | Coulomb");
-  fr.set("Coefficient", 0.0, "mu >= 0");
-  fr.set("Regularization", 1e-3, "eps3 (Tanh) or eps4 (Arctan) > 0: slip velocity scale");
-  fr.set("Tangential Penalty", 0.0,
-         "Coulomb: eps_t > 0, tangential slip per unit friction traction while sticking; "
-         "0 = the contact's solve penalty");
-
-  fr.set("Smoothing", 0.0,
-         "Coulomb: width delta >= 0 of a smoothed stick/slip corner, t = t* / m(|t*| / (mu t_n)) with "
-         "m(s) = (1 + s + sqrt((s-1)^2 + delta^2)) / 2: |t| <= mu t_n still, sticking traction "
-         "softened by about delta^2/4. Removes the corner at which Newton stalls when points keep "
-         "switching between stick and slip (rolling); 0 = the exact return mapping");
+  ContactSettings::declare(c.sublist("Contact", false, "Normal contact"));
+  FrictionSettings::declare(c.sublist("Friction", false, "Friction between body and capstan (formulation.md §3)"));
 
   auto& time = p.sublist("Time", false, "Quasi-static load steps t_n = n dt");
   time.set("Steps", 1, "Number of steps (>= 1)");
   time.set("Step Size", 1.0, "dt > 0");
 
-  auto& sol = p.sublist("Solver", false, "Nonlinear and linear solvers");
-  sol.set("Linear Solver", std::string("Auto"),
-          "Auto | GMRES | CG | Direct (Belos GMRES, Belos CG, Amesos2 KLU2). Auto: Direct up to "
-          "Direct Solver Max Dofs on one rank, GMRES otherwise");
-  sol.set("Direct Solver Max Dofs", 5000, "Auto: largest problem solved directly");
-  sol.set("Preconditioner", std::string("Auto"),
-          "Auto | ILU | Jacobi | MueLu | None (Ifpack2 RILUK per rank, Jacobi relaxation; MueLu smoothed "
-          "aggregation with the rigid-body modes). Auto: MueLu from 1000 dofs, ILU below");
-  sol.set("ILU Level", 1, "ILU: level of fill (>= 0)");
-  sol.set("Preconditioner Reuse", std::string("Adaptive"),
-          "Adaptive | None. Adaptive: Newton builds its preconditioner at each load step's start "
-          "and keeps it across iterations and pressure passes, rebuilding it when a Krylov solve "
-          "needs more than twice the iterations (+10) of the first solve after the last build, or "
-          "hits its limit; None: a new one every Newton iteration");
-  sol.set("Linear Tolerance", 1e-10, "Relative residual of each linear solve (0 < tol < 1)");
-  sol.set("Linear Tolerance Method", std::string("Adaptive"),
-          "Adaptive | Fixed. Adaptive: Eisenstat-Walker forcing terms (each Krylov solve only as "
-          "tight as Newton's progress needs, never tighter than Linear Tolerance); Fixed: every "
-          "Krylov solve to Linear Tolerance. Direct solves are exact either way");
-  sol.set("Max Linear Iterations", 2000, "Krylov iteration limit per linear solve");
-  sol.set("Newton Relative Tolerance", 1e-10, "Converged when |R| <= this x |R| at the step's start");
-  sol.set("Newton Absolute Tolerance", 0.0, "Converged when |R| <= this; 0 = 1e-13 x c x (body size)^2");
-  sol.set("Max Newton Iterations", 30, "Newton iteration limit per solve");
-  sol.set("Predictor", std::string("Tangent"),
-          "Tangent (linear response to the step's prescribed increment, from the previous "
-          "step) | Previous (the previous step's solution with the new boundary values)");
-  sol.set("Line Search", std::string("Backtrack"), "Backtrack | Polynomial | Full Step (NOX line search)");
-  sol.set("Volume Tolerance", 1e-10, "Pressure loop ends when max |v_e/V_e - 1| is below this");
-  sol.set("Max Pressure Iterations", 100, "Most pressure-anchor updates per step");
-  sol.set("Pressure Update", std::string("Auto"),
-          "How the pressure loop moves the element pressure anchors after each Newton solve: "
-          "Saddle Point (positions, anchors and exact contact's multipliers from one block Krylov solve, "
-          "v_e = V_e and g = 0 to first order), "
-          "Anderson (pbar <- p(x), Anderson-accelerated), or Auto (Saddle Point without friction, "
-          "Anderson with it)");
-  sol.set("Pressure Step Schur", std::string("Auto"),
-          "The saddle-point step's approximation of its volume rows' Schur complement: Laplacian "
-          "((eps V)^-1 + 0.15 L^-1, L = G^T diag(K0)^-1 G by 30 CG iterations: it holds Q1P0's nearly "
-          "spurious pressure modes), Diagonal ((eps V)^-1 alone), or Auto (Laplacian with Krylov "
-          "linear solves, Diagonal with a direct solver, whose exact K^-1 leaves it little to gain). "
-          "The same answer either way");
-  sol.set("Pressure Acceleration Depth", 5,
-          "Anderson acceleration depth of the pressure loop (0 = plain pbar <- p(x))");
-  sol.set("Minimum Solve Penalty", -1.0,
-          "Smallest eps1 x c used in the Newton solves: below it the condensed pressure "
-          "cannot be evaluated in double precision; the pressure loop still makes v_e = V_e exact. "
-          "-1: automatic, 3e-2 with the Saddle Point pressure update, 1e-2 with Anderson");
-  sol.sublist("NOX", false, "Passed to NOX unchanged, over capstan's defaults");
-  sol.sublist("Stratimikos", false, "Passed to Stratimikos unchanged, over capstan's defaults");
+  SolverSettings::declare(p.sublist("Solver", false, "Nonlinear and linear solvers"));
 
   auto& out = p.sublist("Output", false, "Where and what to write");
   out.set("Directory", std::string("out"), "Output directory (created if missing)");
@@ -216,22 +119,8 @@ ParameterList validParameters() {
 
 namespace {
 
-struct Validator {
-  std::string file;
-
-  [[noreturn]] void fail(const std::string& path, const std::string& what) const {
-    throw InputError(file + ": " + (path.empty() ? "" : "parameter '" + path + "': ") + what);
-  }
-
-  // A string parameter `path`/`name` of `list` that must be one of `allowed`.
-  void oneOf(const ParameterList& list, const std::string& path, const std::string& name,
-             const std::set<std::string>& allowed) const {
-    const auto& val = list.get<std::string>(name);
-    if (allowed.count(val)) return;
-    std::string names;
-    for (const auto& a : allowed) names += (names.empty() ? "" : ", ") + a;
-    fail(path + "/" + name, "'" + val + "' is not one of " + names);
-  }
+// The parameter reader plus the structural check of the whole scene.
+struct Validator : ParameterReader {
 
   // Unknown names and wrong types; fills in defaults. An int given where a
   // double is expected is accepted and converted.
@@ -303,19 +192,6 @@ std::string trimmed(const std::string& s) {
   return a == std::string::npos ? "" : s.substr(a, b - a + 1);
 }
 
-// 0.01, not 1.00000000000000002e-02: 6 digits where they read back the same, else 17.
-std::string shortest(double x) {
-  std::ostringstream brief, full;
-  brief << x;
-  full << std::setprecision(17) << x;
-  return std::strtod(brief.str().c_str(), nullptr) == x ? brief.str() : full.str();
-}
-
-std::string brief(double x) {  // 6 digits, for descriptions
-  std::ostringstream out;
-  out << x;
-  return out.str();
-}
 
 // A finite double written in decimal (no hex, inf or nan), or false.
 bool readDouble(const std::string& text, double& x) {
@@ -498,7 +374,7 @@ void warnUnreachable(Scene& sc, const CapstanSpec& c) {
   double size = 0, travel = 0;
   for (int i = 0; i < 3; ++i) size = std::max(size, m.max[i] - m.min[i]);
   for (const auto& s : sc.supports)
-    if (s.type == "Displacement") {
+    if (s.type == SupportSpec::Type::Displacement) {
       double v2 = 0;
       for (int i = 0; i < 3; ++i) v2 += s.components[i] ? s.velocity[i] * s.velocity[i] : 0.0;
       travel = std::max(travel, std::sqrt(v2) * T);
@@ -506,7 +382,7 @@ void warnUnreachable(Scene& sc, const CapstanSpec& c) {
   std::array<double, 3> lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
   for (const auto& face : c.contactFaces) {
     // A box face is one side of the box; any other (annulus) face: the whole box.
-    const bool boxFace = m.type == "Box";
+    const bool boxFace = m.type == MeshSpec::Type::Box;
     const int axis = boxFace ? face[0] - 'x' : -1;
     const bool isMax = face.substr(1) == "max";
     for (int i = 0; i < 3; ++i) {
@@ -517,9 +393,7 @@ void warnUnreachable(Scene& sc, const CapstanSpec& c) {
   }
   const double grow = size + travel;
   for (int i = 0; i < 3; ++i) lo[i] -= grow, hi[i] += grow;
-  std::array<double, 3> b = c.axisDirection;
-  const double nb = std::sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
-  for (double& x : b) x /= nb;
+  const Vec3 b = unit(c.axisDirection);
   auto pointToBox = [&](const std::array<double, 3>& p) {
     double d2 = 0;
     for (int i = 0; i < 3; ++i) {
@@ -609,36 +483,6 @@ void applySet(ParameterList& scene, const ParameterList& valid, const std::strin
   }
 }
 
-std::array<bool, 3> components(const std::string& s, const Validator& v, const std::string& path) {
-  std::array<bool, 3> on{false, false, false};
-  if (s.empty()) v.fail(path, "empty: name at least one of x, y, z");
-  for (char ch : s) {
-    if (ch == ' ' || ch == ',') continue;
-    if (ch < 'x' || ch > 'z') v.fail(path, "'" + s + "': components are letters x, y, z");
-    if (on[ch - 'x']) v.fail(path, "'" + s + "': component " + ch + " listed twice");
-    on[ch - 'x'] = true;
-  }
-  return on;
-}
-
-template <class T>
-std::array<T, 3> three(const ParameterList& l, const std::string& name, const Validator& v,
-                       const std::string& path) {
-  const auto& a = l.get<Array<T>>(name);
-  if (a.size() != 3)
-    v.fail(path + "/" + name, "expected 3 values, got " + std::to_string(a.size()));
-  for (const T& x : a)
-    if (!std::isfinite(double(x))) v.fail(path + "/" + name, "must be finite numbers");
-  return {a[0], a[1], a[2]};
-}
-
-double positive(const ParameterList& l, const std::string& name, const Validator& v,
-                const std::string& path) {
-  const double x = l.get<double>(name);
-  if (!(x > 0) || !std::isfinite(x)) v.fail(path + "/" + name, "must be a finite number > 0, got " + shortest(x));
-  return x;
-}
-
 std::vector<std::string> splitNames(const std::string& s) {
   std::vector<std::string> names;
   std::string cur;
@@ -703,72 +547,17 @@ static void rejectOtherMeshTypeParameters(const ParameterList& user, const Valid
                                  (type == "Box" ? "Annulus" : "Box") + ")");
 }
 
-// Rigid Core parameters on another support type would be silently ignored
-// (most likely a misspelled Type): an error, checked before defaults fill in.
-static void rejectRigidCoreParametersElsewhere(const ParameterList& user, const Validator& v) {
-  if (!user.isSublist("Supports")) return;
-  const auto& sups = user.sublist("Supports");
-  for (auto it = sups.begin(); it != sups.end(); ++it) {
-    const std::string name = sups.name(it);
-    if (!sups.isSublist(name)) continue;  // check() reports it
-    const auto& s = sups.sublist(name);
-    const std::string type = s.isType<std::string>("Type") ? s.get<std::string>("Type") : "Fixed";
-    if (type == "Rigid Core") continue;
-    for (const char* n : {"Axis Point", "Axis Direction", "Free Translation", "Force", "Force Ramp Time",
-                          "Rotation", "Torque", "Angular Velocity"})
-      if (s.isParameter(n))
-        v.fail("Supports/" + name + "/" + n, "is a parameter of Type = Rigid Core only, not of " + type);
-  }
-}
-
-// Rigid Core: the rigid body's axis, its free components and its loads.
-static void readRigidCore(const ParameterList& s, const std::string& path, const Validator& v, SupportSpec& spec) {
-  spec.axisPoint = three<double>(s, "Axis Point", v, path);
-  for (double x : spec.axisPoint)
-    if (!std::isfinite(x)) v.fail(path + "/Axis Point", "must be finite numbers");
-  auto& d = spec.axisDirection;
-  d = three<double>(s, "Axis Direction", v, path);
-  const double m = std::max({std::fabs(d[0]), std::fabs(d[1]), std::fabs(d[2])});
-  if (!(m > 0) || !std::isfinite(m)) v.fail(path + "/Axis Direction", "must be a finite non-zero vector");
-  for (double& x : d) x = std::ldexp(x, -std::ilogb(m));
-  const double n = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-  for (double& x : d) x /= n;
-  const std::string free = s.get<std::string>("Free Translation");
-  if (free.find_first_not_of(" ,") != std::string::npos)
-    spec.freeTranslation = components(free, v, path + "/Free Translation");
-  spec.force = three<double>(s, "Force", v, path);
-  for (int i = 0; i < 3; ++i) {
-    if (!std::isfinite(spec.force[i])) v.fail(path + "/Force", "must be finite numbers");
-    if (spec.force[i] != 0 && !spec.freeTranslation[i])
-      v.fail(path + "/Force", std::string("component ") + char('x' + i) + " is not zero, but the core is held along " +
-                                  char('x' + i) + " (not in Free Translation '" + free + "')");
-  }
-  spec.rampTime = s.get<double>("Force Ramp Time");
-  if (!(spec.rampTime >= 0) || !std::isfinite(spec.rampTime)) v.fail(path + "/Force Ramp Time", "must be >= 0");
-  spec.rotation = s.get<std::string>("Rotation");
-  if (spec.rotation != "Fixed" && spec.rotation != "Free" && spec.rotation != "Prescribed")
-    v.fail(path + "/Rotation", "'" + spec.rotation + "' is not a rotation (Fixed, Free, Prescribed)");
-  spec.torque = s.get<double>("Torque");
-  if (!std::isfinite(spec.torque)) v.fail(path + "/Torque", "must be a finite number");
-  if (spec.torque != 0 && spec.rotation != "Free")
-    v.fail(path + "/Torque", "an applied torque needs Rotation = Free (it is '" + spec.rotation + "')");
-  spec.angularVelocity = s.get<double>("Angular Velocity");
-  if (!std::isfinite(spec.angularVelocity)) v.fail(path + "/Angular Velocity", "must be a finite number");
-  if (spec.angularVelocity != 0 && spec.rotation != "Prescribed")
-    v.fail(path + "/Angular Velocity", "needs Rotation = Prescribed (it is '" + spec.rotation + "')");
-}
-
 // A free rigid-core component that nothing can ever hold makes every tangent
 // singular: an input error rather than a failed solve. Capstan contact pushes
 // along directions normal to the capstan's axis, friction along the surface;
 // a rotation is held only by friction.
 static void rejectSingularCores(const Scene& sc, const Validator& v) {
   for (const auto& s : sc.supports) {
-    if (s.type != "Rigid Core") continue;
+    if (!s.isCore()) continue;
     const std::string path = "Supports/" + s.name;
-    if (s.rotation == "Free") {
+    if (s.rotation == SupportSpec::Rotation::Free) {
       bool friction = false;
-      for (const auto& c : sc.capstans) friction |= c.frictionLaw != "None" && c.frictionCoefficient > 0;
+      for (const auto& c : sc.capstans) friction |= c.friction.grips();
       if (!friction)
         v.fail(path + "/Rotation", "Free, but no capstan has friction (Friction/Law and Coefficient > 0): "
                                    "nothing can hold the core's rotation (use Fixed or Prescribed, or add friction)");
@@ -778,8 +567,7 @@ static void rejectSingularCores(const Scene& sc, const Validator& v) {
       bool held = false;
       for (const auto& c : sc.capstans) {
         const auto& b = c.axisDirection;
-        const double nb = std::sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
-        held |= std::fabs(b[i]) / nb < 1 - 1e-12;  // the capstan's normals have a component along i
+        held |= std::fabs(b[i]) / norm(b) < 1 - 1e-12;  // the capstan's normals have a component along i
       }
       if (!held)
         v.fail(path + "/Free Translation",
@@ -791,8 +579,11 @@ static void rejectSingularCores(const Scene& sc, const Validator& v) {
   }
 }
 
+const std::vector<std::pair<const char*, MeshSpec::Type>> MeshSpec::types = {{"Box", Type::Box},
+                                                                              {"Annulus", Type::Annulus}};
+
 std::vector<std::string> MeshSpec::faceNames() const {
-  if (type == "Annulus") return {"inner", "outer", "zmin", "zmax"};
+  if (type == Type::Annulus) return {"inner", "outer", "zmin", "zmax"};
   return {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
 }
 
@@ -821,7 +612,7 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
   if (!outputOverride.empty()) user->sublist("Output").set("Directory", outputOverride);
   applyAccuracyPreset(*user, v);
   rejectOtherMeshTypeParameters(*user, v);
-  rejectRigidCoreParametersElsewhere(*user, v);
+  if (user->isSublist("Supports")) SupportSpec::rejectCoreParametersElsewhere(user->sublist("Supports"), v);
   v.check(*user, valid, "");
 
   Scene sc;
@@ -831,32 +622,32 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
   sc.title = P.get<std::string>("Title");
 
   const auto& mesh = P.sublist("Mesh");
-  sc.mesh.type = mesh.get<std::string>("Type");
+  sc.mesh.type = v.choice(mesh, "Mesh", "Type", MeshSpec::types);
   sc.mesh.partition = mesh.get<std::string>("Partition");
-  v.oneOf(mesh, "Mesh", "Partition", {"Auto", "METIS", "Slabs"});
-  sc.mesh.cells = three<int>(mesh, "Cells", v, "Mesh");
+  v.choice(mesh, "Mesh", "Partition", std::vector<std::pair<const char*, bool>>{{"Auto", 1}, {"METIS", 1}, {"Slabs", 1}});
+  sc.mesh.cells = v.three<int>(mesh, "Mesh", "Cells");
   for (int d = 0; d < 3; ++d)
     if (sc.mesh.cells[d] < 1) v.fail("Mesh/Cells", "each count must be >= 1");
   double nodes = 0;
-  if (sc.mesh.type == "Box") {
-    sc.mesh.min = three<double>(mesh, "Min", v, "Mesh");
-    sc.mesh.max = three<double>(mesh, "Max", v, "Mesh");
+  if (sc.mesh.type == MeshSpec::Type::Box) {
+    sc.mesh.min = v.three<double>(mesh, "Mesh", "Min");
+    sc.mesh.max = v.three<double>(mesh, "Mesh", "Max");
     for (int d = 0; d < 3; ++d)
       if (!(sc.mesh.max[d] > sc.mesh.min[d]))
         v.fail("Mesh/Max", "each component must exceed Mesh/Min (zero or negative size)");
     nodes = double(sc.mesh.cells[0] + 1.0) * (sc.mesh.cells[1] + 1.0) * (sc.mesh.cells[2] + 1.0);
-  } else if (sc.mesh.type == "Annulus") {
+  } else {
     auto& m = sc.mesh;
-    m.center = three<double>(mesh, "Center", v, "Mesh");
+    m.center = v.three<double>(mesh, "Mesh", "Center");
     for (double x : m.center)
       if (!std::isfinite(x)) v.fail("Mesh/Center", "must be finite numbers");
-    m.innerRadius = positive(mesh, "Inner Radius", v, "Mesh");
-    m.outerRadius = positive(mesh, "Outer Radius", v, "Mesh");
-    m.length = positive(mesh, "Length", v, "Mesh");
+    m.innerRadius = v.positive(mesh, "Mesh", "Inner Radius");
+    m.outerRadius = v.positive(mesh, "Mesh", "Outer Radius");
+    m.length = v.positive(mesh, "Mesh", "Length");
     if (!(m.outerRadius > m.innerRadius)) v.fail("Mesh/Outer Radius", "must exceed Mesh/Inner Radius");
     if (m.cells[1] < 3) v.fail("Mesh/Cells", "an annulus needs at least 3 circumferential cells");
-    m.outerCellRatio = positive(mesh, "Outer Cell Ratio", v, "Mesh");
-    m.fineSector = three<double>(mesh, "Fine Sector", v, "Mesh");
+    m.outerCellRatio = v.positive(mesh, "Mesh", "Outer Cell Ratio");
+    m.fineSector = v.three<double>(mesh, "Mesh", "Fine Sector");
     const auto& fs = m.fineSector;
     if (!std::isfinite(fs[0]) || !(fs[1] >= 0 && fs[1] < 360))
       v.fail("Mesh/Fine Sector", "the centre must be finite and the width in [0, 360) degrees");
@@ -865,8 +656,6 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
     m.min = {m.center[0] - m.outerRadius, m.center[1] - m.outerRadius, m.center[2]};
     m.max = {m.center[0] + m.outerRadius, m.center[1] + m.outerRadius, m.center[2] + m.length};
     nodes = double(m.cells[0] + 1.0) * m.cells[1] * (m.cells[2] + 1.0);
-  } else {
-    v.fail("Mesh/Type", "'" + sc.mesh.type + "' is not a mesh type (Box, Annulus)");
   }
   // Local dof ids are ints: 3 x nodes must stay below 2^31.
   if (3 * nodes > double(INT_MAX))
@@ -879,31 +668,16 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
   const auto& mat = P.sublist("Material");
   if (mat.get<std::string>("Model") != "Incompressible Neo-Hookean")
     v.fail("Material/Model", "'" + mat.get<std::string>("Model") + "' is not a model (Incompressible Neo-Hookean)");
-  sc.c = positive(mat, "c", v, "Material");
-  sc.pressurePenalty = positive(mat, "Pressure Penalty", v, "Material");
+  sc.c = v.positive(mat, "Material", "c");
+  sc.pressurePenalty = v.positive(mat, "Material", "Pressure Penalty");
 
-  sc.bodyForce = three<double>(P.sublist("Loads"), "Body Force", v, "Loads");
+  sc.bodyForce = v.three<double>(P.sublist("Loads"), "Loads", "Body Force");
   for (double b : sc.bodyForce)
     if (!std::isfinite(b)) v.fail("Loads/Body Force", "must be finite numbers");
 
   const auto& sups = P.sublist("Supports");
-  for (auto it = sups.begin(); it != sups.end(); ++it) {
-    const std::string name = sups.name(it), path = "Supports/" + name;
-    const auto& s = sups.sublist(name);
-    SupportSpec spec;
-    spec.name = name;
-    spec.face = s.get<std::string>("Face");
-    spec.type = s.get<std::string>("Type");
-    if (!faceNames.count(spec.face)) v.fail(path + "/Face", "'" + spec.face + "' is not a face of the mesh (" + faceText + ")");
-    if (spec.type == "Fixed" || spec.type == "Rigid Core") spec.components = {true, true, true};
-    else if (spec.type == "Roller" || spec.type == "Foundation" || spec.type == "Displacement")
-      spec.components = components(s.get<std::string>("Components"), v, path + "/Components");
-    else v.fail(path + "/Type", "'" + spec.type + "' is not a support type (Fixed, Roller, Foundation, Displacement, Rigid Core)");
-    if (spec.type == "Foundation") spec.stiffness = positive(s, "Stiffness", v, path);
-    spec.velocity = three<double>(s, "Velocity", v, path);
-    if (spec.type == "Rigid Core") readRigidCore(s, path, v, spec);
-    sc.supports.push_back(spec);
-  }
+  for (auto it = sups.begin(); it != sups.end(); ++it)
+    sc.supports.push_back(SupportSpec::parse(sups.sublist(sups.name(it)), sups.name(it), faceNames, v));
 
   const auto& caps = P.sublist("Capstans");
   for (auto it = caps.begin(); it != caps.end(); ++it) {
@@ -911,122 +685,41 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
     const auto& c = caps.sublist(name);
     CapstanSpec cs;
     cs.name = name;
-    cs.radius = positive(c, "Radius", v, path);
-    cs.axisPoint = three<double>(c, "Axis Point", v, path);
-    cs.axisDirection = three<double>(c, "Axis Direction", v, path);
+    cs.radius = v.positive(c, path, "Radius");
+    cs.axisPoint = v.three<double>(c, path, "Axis Point");
+    cs.axisDirection = v.three<double>(c, path, "Axis Direction");
     {
-      // Scaled by a power of two (exact: a direction of ordinary size keeps
-      // its bits), so that 1e-200 or 1e200 do not under- or overflow |beta|^2.
       auto& b = cs.axisDirection;
       const double m = std::max({std::fabs(b[0]), std::fabs(b[1]), std::fabs(b[2])});
       if (!(m > 0)) v.fail(path + "/Axis Direction", "must be a non-zero vector, got {0, 0, 0}");
-      for (double& x : b) x = std::ldexp(x, -std::ilogb(m));
+      b = scaledDirection(b);
     }
-    cs.velocity = three<double>(c, "Velocity", v, path);
-    cs.angularVelocity = c.get<double>("Angular Velocity");
-    if (!std::isfinite(cs.angularVelocity)) v.fail(path + "/Angular Velocity", "must be a finite number");
+    cs.velocity = v.three<double>(c, path, "Velocity");
+    cs.angularVelocity = v.finite(c, path, "Angular Velocity");
     cs.contactFaces = splitNames(c.get<std::string>("Contact Faces"));
     if (cs.contactFaces.empty()) v.fail(path + "/Contact Faces", "name at least one face");
     for (const auto& f : cs.contactFaces)
       if (!faceNames.count(f)) v.fail(path + "/Contact Faces", "'" + f + "' is not a face of the mesh (" + faceText + ")");
-    const auto& ct = c.sublist("Contact");
-    cs.method = ct.get<std::string>("Method");
-    if (cs.method != "Penalty" && cs.method != "Augmented Lagrangian")
-      v.fail(path + "/Contact/Method", "'" + cs.method + "' is not a method (Penalty, Augmented Lagrangian)");
-    cs.penalty = positive(ct, "Penalty", v, path + "/Contact");
-    cs.penetrationTolerance = ct.get<double>("Penetration Tolerance");
-    if (!(cs.penetrationTolerance >= 0)) v.fail(path + "/Contact/Penetration Tolerance", "must be >= 0");
-    cs.minimumSolvePenalty = ct.get<double>("Minimum Solve Penalty");
-    if (!std::isfinite(cs.minimumSolvePenalty))
-      v.fail(path + "/Contact/Minimum Solve Penalty", "must be a finite number");
-    const std::string rule = ct.get<std::string>("Quadrature");
-    if (rule == "Auto") cs.quadrature = cs.method == "Augmented Lagrangian" ? 2 : 0;
-    else if (rule == "Gauss 2x2") cs.quadrature = 0;
-    else if (rule == "Gauss 3x3") cs.quadrature = 1;
-    else if (rule == "Nodal") cs.quadrature = 2;
-    else v.fail(path + "/Contact/Quadrature", "'" + rule + "' is not a rule (Auto, Gauss 2x2, Gauss 3x3, Nodal)");
-    if (cs.method == "Augmented Lagrangian" && cs.quadrature != 2)
-      v.fail(path + "/Contact/Quadrature",
-             "the Augmented Lagrangian needs Nodal (or Auto): zero gap at every Gauss point of flat "
-             "faces against a curved capstan is impossible, and the multipliers would never settle");
-    cs.smoothing = ct.get<double>("Smoothing");
-    if (!(cs.smoothing >= 0) || !std::isfinite(cs.smoothing)) v.fail(path + "/Contact/Smoothing", "must be >= 0");
-    cs.maxAugmentations = ct.get<int>("Max Augmentations");
-    if (cs.maxAugmentations < 1) v.fail(path + "/Contact/Max Augmentations", "must be >= 1");
-    const auto& fr = c.sublist("Friction");
-    cs.frictionLaw = fr.get<std::string>("Law");
-    if (cs.frictionLaw != "None" && cs.frictionLaw != "Tanh" && cs.frictionLaw != "Arctan" &&
-        cs.frictionLaw != "Coulomb")
-      v.fail(path + "/Friction/Law", "'" + cs.frictionLaw + "' is not a law (None, Tanh, Arctan, Coulomb)");
-    cs.frictionCoefficient = fr.get<double>("Coefficient");
-    if (!(cs.frictionCoefficient >= 0) || !std::isfinite(cs.frictionCoefficient))
-      v.fail(path + "/Friction/Coefficient", "must be >= 0");
-    cs.regularization = fr.get<double>("Regularization");
-    if (!(cs.regularization > 0) || !std::isfinite(cs.regularization))
-      v.fail(path + "/Friction/Regularization", "must be > 0");
-    cs.frictionSmoothing = fr.get<double>("Smoothing");
-    if (!(cs.frictionSmoothing >= 0) || !std::isfinite(cs.frictionSmoothing))
-      v.fail(path + "/Friction/Smoothing", "must be >= 0");
-    cs.tangentialPenalty = fr.get<double>("Tangential Penalty");
-    if (!(cs.tangentialPenalty >= 0) || !std::isfinite(cs.tangentialPenalty))
-      v.fail(path + "/Friction/Tangential Penalty", "must be >= 0");
+    cs.contact = ContactSettings::parse(c.sublist("Contact"), path + "/Contact", v);
+    cs.friction = FrictionSettings::parse(c.sublist("Friction"), path + "/Friction", v);
     sc.capstans.push_back(cs);
   }
 
   const auto& time = P.sublist("Time");
   sc.steps = time.get<int>("Steps");
   if (sc.steps < 1) v.fail("Time/Steps", "must be >= 1, got " + std::to_string(sc.steps));
-  sc.stepSize = positive(time, "Step Size", v, "Time");
+  sc.stepSize = v.positive(time, "Time", "Step Size");
   rejectSingularCores(sc, v);
   for (auto& s : sc.supports)
-    if (s.type == "Rigid Core" && s.rampTime == 0) s.rampTime = sc.stepSize;
+    if (s.isCore() && s.rampTime == 0) s.rampTime = sc.stepSize;
 
-  sc.solver = P.sublist("Solver");
-  const auto& sol = sc.solver;
-  auto oneOf = [&](const std::string& name, const std::set<std::string>& allowed) {
-    v.oneOf(sol, "Solver", name, allowed);
-  };
-  oneOf("Linear Solver", {"Auto", "GMRES", "CG", "Direct"});
+  const bool friction = std::any_of(sc.capstans.begin(), sc.capstans.end(),
+                                    [](const CapstanSpec& c) { return c.friction.on(); });
+  sc.solver = SolverSettings::parse(P.sublist("Solver"), ParameterReader{file}, friction);
   for (const auto& c : sc.capstans)
-    if (c.frictionLaw != "None" && sol.get<std::string>("Linear Solver") == "CG")
+    if (c.friction.on() && sc.solver.linearSolver == SolverSettings::LinearSolver::CG)
       v.fail("Solver/Linear Solver", "CG needs a symmetric matrix; friction on capstan '" + c.name +
                                          "' makes it non-symmetric (use Auto, GMRES or Direct)");
-  oneOf("Preconditioner", {"Auto", "ILU", "Jacobi", "MueLu", "None"});
-  oneOf("Line Search", {"Backtrack", "Polynomial", "Full Step"});
-  oneOf("Predictor", {"Tangent", "Previous"});
-  oneOf("Linear Tolerance Method", {"Adaptive", "Fixed"});
-  oneOf("Preconditioner Reuse", {"Adaptive", "None"});
-  oneOf("Pressure Update", {"Auto", "Saddle Point", "Anderson"});
-  oneOf("Pressure Step Schur", {"Auto", "Laplacian", "Diagonal"});
-  for (const char* n : {"Linear Tolerance", "Newton Relative Tolerance", "Volume Tolerance"}) {
-    const double x = sol.get<double>(n);
-    if (!(x > 0 && x < 1)) v.fail(std::string("Solver/") + n, "must be in (0, 1)");
-  }
-  if (!(sol.get<double>("Newton Absolute Tolerance") >= 0)) v.fail("Solver/Newton Absolute Tolerance", "must be >= 0");
-  {
-    const double x = sol.get<double>("Minimum Solve Penalty");
-    if (!(x > 0 || x == -1) || !std::isfinite(x))
-      v.fail("Solver/Minimum Solve Penalty", "must be > 0, or -1 (automatic), got " + Teuchos::toString(x));
-  }
-  // The automatic choices, resolved here so that the run (and its summary)
-  // sees what is used. Pressure Update: the saddle-point step without
-  // friction; with friction the Anderson loop, whose extra passes converge the
-  // path-dependent friction multipliers further than their tolerance (the
-  // saddle-point step met the tolerances but moved H4's finely stepped force
-  // by 1.3e-4 and 1 vs 2 ranks on the pinch roller by 1.5e-7; not measured
-  // faster there). Minimum Solve Penalty: the fastest on G1 for each update
-  // (docs/performance.md): 3e-2 with the saddle-point step, 1e-2 with Anderson.
-  if (sol.get<std::string>("Pressure Update") == "Auto") {
-    const bool friction = std::any_of(sc.capstans.begin(), sc.capstans.end(),
-                                      [](const CapstanSpec& c) { return c.frictionLaw != "None"; });
-    sc.solver.set("Pressure Update", std::string(friction ? "Anderson" : "Saddle Point"));
-  }
-  if (sol.get<double>("Minimum Solve Penalty") == -1)
-    sc.solver.set("Minimum Solve Penalty", sol.get<std::string>("Pressure Update") == "Saddle Point" ? 3e-2 : 1e-2);
-  for (const char* n : {"Max Linear Iterations", "Max Newton Iterations", "Max Pressure Iterations"})
-    if (sol.get<int>(n) < 1) v.fail(std::string("Solver/") + n, "must be >= 1");
-  if (sol.get<int>("ILU Level") < 0) v.fail("Solver/ILU Level", "must be >= 0");
-  if (sol.get<int>("Pressure Acceleration Depth") < 0) v.fail("Solver/Pressure Acceleration Depth", "must be >= 0");
 
   const auto& out = P.sublist("Output");
   sc.outputDirectory = out.get<std::string>("Directory");

@@ -8,10 +8,16 @@
 #include <string>
 #include <vector>
 
+#include "effects/contact_settings.hpp"
+#include "effects/friction_settings.hpp"
+#include "solver_settings.hpp"
+#include "support_settings.hpp"
+
 namespace capstan {
 
 struct MeshSpec {
-  std::string type;  // Box | Annulus
+  enum class Type { Box, Annulus };
+  Type type = Type::Box;
   std::array<double, 3> min{}, max{};  // Box: its corners; Annulus: its bounding box
   std::array<int, 3> cells{};          // Box: x, y, z; Annulus: radial, circumferential, axial
   // Annulus: axis point at the zmin end (axis along +z), radii, length.
@@ -21,38 +27,19 @@ struct MeshSpec {
   std::array<double, 3> fineSector{};    // {centre deg, width deg, fraction of cells}
   std::string partition = "Auto";        // over the MPI ranks: Auto | METIS | Slabs (partitionFor)
   std::vector<std::string> faceNames() const;
+  static const std::vector<std::pair<const char*, Type>> types;
 };
 
-struct SupportSpec {
-  std::string name, face, type;        // type: Fixed | Roller | Foundation | Displacement | Rigid Core
-  std::array<bool, 3> components{};    // which of x, y, z the support acts on
-  double stiffness = 0;                // Foundation
-  std::array<double, 3> velocity{};    // Displacement: u = velocity * t
-  // Rigid Core (interface.md "Pinch roller"): the face follows a rigid body
-  // turning about axisDirection (unit) through axisPoint and translating along
-  // the free components.
-  std::array<double, 3> axisPoint{}, axisDirection{0, 0, 1};
-  std::array<bool, 3> freeTranslation{};
-  std::array<double, 3> force{};       // external force on the core, ramped to rampTime
-  double rampTime = 0;                 // > 0 (the first step's end when not given)
-  std::string rotation = "Fixed";      // Fixed | Free | Prescribed
-  double torque = 0;                   // Free: external torque on the core, ramped like force
-  double angularVelocity = 0;          // Prescribed
-};
-
+// A rigid cylinder (formulation.md §2): its motion here, its contact and
+// friction in their own settings.
 struct CapstanSpec {
   std::string name;
   double radius = 0;
   std::array<double, 3> axisPoint{}, axisDirection{}, velocity{};
   double angularVelocity = 0;
   std::vector<std::string> contactFaces;
-  std::string method;  // Penalty | Augmented Lagrangian
-  double penalty = 0, penetrationTolerance = 0, minimumSolvePenalty = 0;
-  int maxAugmentations = 0;
-  int quadrature = 0;  // kernels::FaceRule: 0 Gauss 2x2, 1 Gauss 3x3, 2 Nodal
-  double smoothing = 0;  // Contact/Smoothing: pressure scale of the smoothed contact corner
-  std::string frictionLaw;  // None | Tanh | Arctan | Coulomb
-  double frictionCoefficient = 0, regularization = 0, tangentialPenalty = 0, frictionSmoothing = 0;
+  ContactSettings contact;
+  FrictionSettings friction;
 };
 
 struct Scene {
@@ -64,7 +51,7 @@ struct Scene {
   std::vector<CapstanSpec> capstans;
   int steps = 1;
   double stepSize = 1;
-  Teuchos::ParameterList solver;   // the resolved Solver sublist
+  SolverSettings solver;           // the Solver sublist, typed and resolved
   std::string outputDirectory;
   bool writeFields = true;
   int checkpointEvery = 0;         // Output/Checkpoint Every: steps between checkpoints, 0 = none

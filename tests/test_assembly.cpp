@@ -20,16 +20,16 @@ namespace {
 
 Scene boxScene() {
   Scene s;
-  s.mesh.type = "Box";
+  s.mesh.type = MeshSpec::Type::Box;
   s.mesh.min = {0, 0, 0};
   s.mesh.max = {2, 1, 1.5};
   s.mesh.cells = {4, 2, 3};
   s.c = 1.3;
   s.pressurePenalty = 1e-2;
-  s.solver = validParameters().sublist("Solver");
-  SupportSpec fixed{"base", "ymin", "Fixed", {true, true, true}, 0, {0, 0, 0}};
-  SupportSpec roll{"side", "xmin", "Roller", {true, false, false}, 0, {0, 0, 0}};
-  SupportSpec spring{"spring", "zmax", "Foundation", {false, true, true}, 0.7, {0, 0, 0}};
+  s.solver = SolverSettings::defaults();
+  SupportSpec fixed{"base", "ymin", SupportSpec::Type::Fixed, {true, true, true}, 0, {0, 0, 0}};
+  SupportSpec roll{"side", "xmin", SupportSpec::Type::Roller, {true, false, false}, 0, {0, 0, 0}};
+  SupportSpec spring{"spring", "zmax", SupportSpec::Type::Foundation, {false, true, true}, 0.7, {0, 0, 0}};
   s.supports = {fixed, roll, spring};
   return s;
 }
@@ -176,6 +176,20 @@ TEST(Assembly, PredictorLoadMatchesMatrixAndDifferences) {
     if (!assembly.ownedConstrained(d)) {
       EXPECT_NEAR(k[d], (p[d] - m[d]) / (2 * h), 1e-6 * largest) << "dof " << d;
     }
+}
+
+// evaluate()'s phases are timed in turn within its total.
+TEST(Assembly, PhaseSecondsAddUpWithinTheTotal) {
+  BoxProblem problem(boxScene(), 1.0);
+  auto& [scene, mesh, assembly, newton, u, f] = problem;
+  auto W = newton.matrix();
+  ASSERT_TRUE(assembly.evaluate(u, &f, W.get()));
+  ASSERT_TRUE(assembly.evaluate(u, &f, nullptr));
+  const auto& p = assembly.phaseSeconds();
+  for (double s : {p.import, p.launch, p.scatter, p.constraints, p.coreCoupling, p.matrixExport}) EXPECT_GE(s, 0.0);
+  EXPECT_GT(p.launch, 0.0);
+  const double sum = p.import + p.launch + p.scatter + p.constraints + p.coreCoupling + p.matrixExport;
+  EXPECT_LE(sum, assembly.assemblySeconds() * (1 + 1e-12));
 }
 
 // A view's values on the host.
@@ -334,9 +348,9 @@ TEST(PressureStep, PredictsTheVolumeErrorAfterNewton) {
 TEST(PressureStep, SchurModelsGiveTheSameStep) {
   Scene fine = boxScene();
   fine.mesh.cells = {16, 8, 12};
-  fine.solver.set("Linear Solver", std::string("GMRES"));
-  fine.solver.set("Preconditioner", std::string("MueLu"));
-  fine.solver.set("Minimum Solve Penalty", 3e-2);  // as Auto sets it for the saddle-point step
+  fine.solver.linearSolver = SolverSettings::LinearSolver::GMRES;
+  fine.solver.preconditioner = SolverSettings::Preconditioner::MueLu;
+  fine.solver.minimumSolvePenalty = 3e-2;  // as Auto sets it for the saddle-point step
   BoxProblem problem(fine, 0.2);
   auto& [scene, mesh, assembly, newton, u, f] = problem;
   auto W = newton.matrix();
@@ -408,9 +422,9 @@ TEST(PressureStep, MovesContactMultipliersWithTheVolumes) {
   cap.radius = 1;
   cap.axisPoint = {1.1, 1 + 1 - 0.08, 0}, cap.axisDirection = {0, 0, 1};
   cap.contactFaces = {"ymax"};
-  cap.method = "Augmented Lagrangian", cap.penalty = 1e-2, cap.maxAugmentations = 50;
-  cap.minimumSolvePenalty = -1;
-  cap.frictionLaw = "None";
+  cap.contact.method = ContactSettings::Method::AugmentedLagrangian;
+  cap.contact.penalty = 1e-2, cap.contact.maxAugmentations = 50;
+  cap.contact.minimumSolvePenalty = -1;
   scene.capstans = {cap};
   BoxProblem problem(scene, 0.3);
   auto& [sc, mesh, assembly, newton, u, f] = problem;

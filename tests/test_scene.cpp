@@ -141,7 +141,7 @@ TEST_F(SceneTest, ValidSceneLoads) {
   const Scene s = loadScene(file, {}, "");
   EXPECT_EQ(s.file, file);
   EXPECT_EQ(s.title, "test scene");
-  EXPECT_EQ(s.mesh.type, "Box");
+  EXPECT_EQ(s.mesh.type, MeshSpec::Type::Box);
   EXPECT_EQ(s.mesh.cells, (std::array<int, 3>{4, 2, 2}));
   EXPECT_EQ(s.mesh.max, (std::array<double, 3>{2, 1, 1}));
   EXPECT_EQ(s.c, 1.0);
@@ -153,10 +153,10 @@ TEST_F(SceneTest, ValidSceneLoads) {
   EXPECT_EQ(s.supports[0].name, "base");
   EXPECT_EQ(s.supports[0].components, (std::array<bool, 3>{true, true, true}));
   EXPECT_EQ(s.supports[1].name, "pull");
-  EXPECT_EQ(s.supports[1].type, "Displacement");
+  EXPECT_EQ(s.supports[1].type, SupportSpec::Type::Displacement);
   EXPECT_EQ(s.supports[1].components, (std::array<bool, 3>{true, false, false}));
   EXPECT_EQ(s.supports[1].velocity, (std::array<double, 3>{0.2, 0, 0}));
-  EXPECT_EQ(s.supports[2].type, "Foundation");
+  EXPECT_EQ(s.supports[2].type, SupportSpec::Type::Foundation);
   EXPECT_EQ(s.supports[2].stiffness, 1.0);
   EXPECT_TRUE(s.capstans.empty());
 }
@@ -181,7 +181,7 @@ TEST_F(SceneTest, DefaultsAreFilledIn) {
   const Scene s = loadScene(file, {}, "");
   const auto valid = validParameters();
   EXPECT_EQ(s.title, "");
-  EXPECT_EQ(s.mesh.type, "Box");
+  EXPECT_EQ(s.mesh.type, MeshSpec::Type::Box);
   EXPECT_EQ(s.mesh.min, (std::array<double, 3>{0, 0, 0}));
   EXPECT_EQ(s.mesh.max, (std::array<double, 3>{1, 1, 1}));
   EXPECT_EQ(s.mesh.cells, (std::array<int, 3>{2, 3, 4}));
@@ -467,13 +467,13 @@ TEST_F(SceneTest, AccuracyPresets) {
   const std::array<int, 3> cells = loadScene(file, {}, "").mesh.cells;
   const Scene scene = loadScene(file, {"Accuracy=Scene"}, "");
   EXPECT_EQ(scene.mesh.cells, cells);
-  EXPECT_EQ(scene.solver.get<double>("Newton Relative Tolerance"), 1e-10);
+  EXPECT_EQ(scene.solver.newtonRelativeTolerance, 1e-10);
   const Scene draft = loadScene(file, {"Accuracy=Draft"}, "");
   EXPECT_EQ(draft.mesh.cells, cells);
-  EXPECT_EQ(draft.solver.get<double>("Newton Relative Tolerance"), 1e-6);
+  EXPECT_EQ(draft.solver.newtonRelativeTolerance, 1e-6);
   // A tolerance the scene sets itself wins over the preset.
   const Scene draftOwn = loadScene(file, {"Accuracy=Draft", "Solver/Newton Relative Tolerance=1e-9"}, "");
-  EXPECT_EQ(draftOwn.solver.get<double>("Newton Relative Tolerance"), 1e-9);
+  EXPECT_EQ(draftOwn.solver.newtonRelativeTolerance, 1e-9);
   const Scene standard = loadScene(file, {"Accuracy=Standard"}, "");
   const Scene fine = loadScene(file, {"Accuracy=Fine"}, "");
   for (int d = 0; d < 3; ++d) {
@@ -507,8 +507,8 @@ TEST_F(SceneTest, SetReachesNamedObjectsAndAbsentSublists) {
   ASSERT_EQ(s.supports.size(), 3u);
   EXPECT_EQ(s.supports[1].velocity, (std::array<double, 3>{-0.5, 0, 0.25}));
   EXPECT_EQ(s.steps, 7);
-  EXPECT_EQ(s.solver.get<std::string>("Line Search"), "Full Step");
-  EXPECT_EQ(s.solver.get<int>("Max Newton Iterations"), 3);
+  EXPECT_EQ(s.solver.lineSearch, SolverSettings::LineSearch::FullStep);
+  EXPECT_EQ(s.solver.maxNewtonIterations, 3);
   EXPECT_EQ(s.title, "changed");
   EXPECT_EQ(s.pressurePenalty, 1e-13);
   // A parameter the scene file does not give (its sublist absent too): typed from the valid list.
@@ -517,7 +517,7 @@ TEST_F(SceneTest, SetReachesNamedObjectsAndAbsentSublists) {
 </ParameterList>
 )X");
   const Scene b = loadScene(bare, {"Solver/Linear Solver=Direct", "Time/Step Size=0.5"}, "");
-  EXPECT_EQ(b.solver.get<std::string>("Linear Solver"), "Direct");
+  EXPECT_EQ(b.solver.linearSolver, SolverSettings::LinearSolver::Direct);
   EXPECT_EQ(b.stepSize, 0.5);
 }
 
@@ -594,12 +594,12 @@ TEST_F(SceneTest, CapstanOfG1) {
   EXPECT_EQ(c.axisDirection, (std::array<double, 3>{0, 0, 1}));
   EXPECT_EQ(c.velocity, (std::array<double, 3>{0, -0.1, 0}));
   EXPECT_EQ(c.contactFaces, (std::vector<std::string>{"ymax"}));
-  EXPECT_EQ(c.method, "Augmented Lagrangian");
-  EXPECT_EQ(c.quadrature, 2) << "Auto: the augmented Lagrangian uses the nodal rule";
-  EXPECT_LT(c.minimumSolvePenalty, 0) << "automatic solve penalty by default";
+  EXPECT_EQ(c.contact.method, ContactSettings::Method::AugmentedLagrangian);
+  EXPECT_EQ(c.contact.quadrature, ContactSettings::Quadrature::Nodal) << "Auto: the augmented Lagrangian uses the nodal rule";
+  EXPECT_LT(c.contact.minimumSolvePenalty, 0) << "automatic solve penalty by default";
   const Scene p = loadScene(std::string(CAPSTAN_INPUTS_DIR) + "/seed/g1.xml",
                             {"Capstans/capstan/Contact/Method=Penalty"}, "");
-  EXPECT_EQ(p.capstans[0].quadrature, 0) << "Auto: the penalty method uses Gauss 2x2";
+  EXPECT_EQ(p.capstans[0].contact.quadrature, ContactSettings::Quadrature::Gauss2x2) << "Auto: the penalty method uses Gauss 2x2";
 }
 
 TEST_F(SceneTest, CapstanInputErrors) {

@@ -101,11 +101,12 @@ class Test:
         except subprocess.TimeoutExpired:
             self.fatal(f"timed out after {timeout} s: {' '.join(cmd)}")
 
-    def run_scene(self, scene, out, sets=(), ranks=1, env=None, quiet=True, expect_rc=0):
-        """Runs SCENE into the scratch subdirectory OUT; checks the exit status and
-        returns (completed process, summary dict or None, output directory)."""
+    def run_scene(self, scene, out, sets=(), ranks=1, env=None, quiet=True, expect_rc=0, extra=()):
+        """Runs SCENE into the scratch subdirectory OUT (EXTRA: more driver options,
+        e.g. ["--log", "newton"]); checks the exit status and returns (completed
+        process, summary dict or None, output directory)."""
         outdir = self.path(out)
-        args = ["run", scene, "--output", outdir]
+        args = ["run", scene, "--output", outdir] + list(extra)
         for s in sets:
             args += ["--set", s]
         if quiet:
@@ -124,6 +125,17 @@ class Test:
             except ValueError as e:
                 self.check(False, f"{sp}: not valid JSON: {e}")
         return p, summary, outdir
+
+    @staticmethod
+    def log_events(outdir, event=None):
+        """The events of OUTDIR/log.jsonl (a run with --log TOPIC), those named
+        EVENT only if given, in order."""
+        path = os.path.join(outdir, "log.jsonl")
+        if not os.path.isfile(path):
+            return []
+        with open(path) as f:
+            events = [json.loads(line) for line in f if line.strip()]
+        return [e for e in events if event is None or e.get("event") == event]
 
     def conforms(self, outdir, scene=None):
         """shared/tools/check_summary.py on OUTDIR/summary.json (with --scene SCENE)."""

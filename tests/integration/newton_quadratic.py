@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Newton converges quadratically (the tangent is consistent with the residual).
 
-Runs inputs/shear.xml with CAPSTAN_NEWTON_LOG=1, which prints one line per Newton
-solve:   newton |R|: r0 r1 r2 ...  (N linear; preconditioners built: P; T s)
+Runs inputs/shear.xml with --log newton, which writes one event per Newton solve
+to OUTDIR/log.jsonl:  {"event": "newton", "step": k, "residuals": [r0, r1, ...], ...}
 as given (Auto linear solver: direct on one rank, tangent predictor), with
 Solver/Predictor=Previous (Newton starts farther from the solution: longer
 histories), and with Solver/Linear Solver=GMRES (the iterative path that
@@ -29,7 +29,6 @@ directions differently), so a three-point order estimate scatters between 1.2 an
 """
 import math
 import os
-import re
 import sys
 
 sys.dont_write_bytecode = True  # nothing written into the source tree
@@ -49,23 +48,14 @@ L = max(h - l for h, l in zip(info.vector("Mesh/Max", [1, 1, 1]), info.vector("M
 force_scale = c * L * L
 print(f"  c = {c}, body size L = {L}: force scale c L^2 = {force_scale}")
 
-LINE = re.compile(r"^\s*newton \|R\|:((?:\s+\S+)+?)\s+\((\d+) linear(?:; preconditioners built: \d+)?(?:; \S+ s)?\)\s*$")
-STEP = re.compile(r"^step (\d+)/(\d+)")
 
 
-def parse(stdout):
-    """[(step, [solve histories])] from the driver's stdout."""
-    steps, pending = [], []
-    for line in stdout.splitlines():
-        m = LINE.match(line)
-        if m:
-            pending.append([float(x) for x in m.group(1).split()])
-            continue
-        m = STEP.match(line)
-        if m:
-            steps.append((int(m.group(1)), pending))
-            pending = []
-    return steps
+def parse(outdir):
+    """[(step, [solve histories])] from the run's log.jsonl."""
+    steps = {}
+    for e in Test.log_events(outdir, "newton"):
+        steps.setdefault(e["step"], []).append([float(r) for r in e["residuals"]])
+    return sorted(steps.items())
 
 
 total_pairs = 0
@@ -73,8 +63,8 @@ for label, sets in (("as given", []), ("Predictor=Previous", ["Solver/Predictor=
                     ("GMRES", ["Solver/Linear Solver=GMRES", "Solver/Linear Tolerance Method=Fixed"])):
     print(f"\n  --- shear.xml, {label}")
     p, s, out = T.run_scene(scene, f"shear-{len(sets)}-{label.split('=')[0].replace(' ', '')}", sets=sets,
-                            env={"CAPSTAN_NEWTON_LOG": "1"}, quiet=False)
-    steps = parse(p.stdout)
+                            extra=["--log", "newton"])
+    steps = parse(out)
     T.check(len(steps) > 0 and all(h for _, h in steps),
             f"{label}: Newton log parsed: {len(steps)} steps, {sum(len(h) for _, h in steps)} solves")
     if not steps:

@@ -1,0 +1,217 @@
+#include "augmentation.hpp"
+
+#include <Teuchos_CommHelpers.hpp>
+
+#include <chrono>
+#include <cstdio>
+
+#include "effect_state.hpp"
+
+namespace capstan {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// The saddle-point pressure step's GMRES tolerance (relative): the volume
+// error then falls about 1000x per pass in the linear regime.
+constexpr double kPressureStepTolerance = 1e-3;
+// ... and the volume error it aims to leave, as a fraction of the volume
+// tolerance: the pass it ends is then the last.
+constexpr double kPressureStepVolumeMargin = 0.3;
+// Passes after the first start below the step's tolerance: x must still
+// respond to the new multipliers, so they reduce the residual by this factor
+// (one Newton iteration, usually). 1e-6 took two and gave the same answer;
+// 1e-2 is too loose and the pressure loop stalls (docs/numerics.md).
+constexpr double kLaterPassReduction = 1e-4;
+
+json::Object eventOf(const char* name) { return json::Object().add("event", json::string(name)); }
+
+}  // namespace
+
+AugmentationLoop::AugmentationLoop(Model& model, Log& log, bool checkTangent)
+    : m_(model), log_(log), checkTangent_(checkTangent) {}
+
+bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string& failure) {
+  const auto& sol = m_.scene.solver;
+  auto& assembly = *m_.assembly;
+  const auto& effects = assembly.effects();
+  if (checkTangent_) checkTangent();
+  // r0 is capped by the body's force scale c L^2: with a small penalty the bare
+  // increment's residual is huge (volume error / eps), and a tolerance relative
+  // to it would accept a poorly converged state.
+  const double r0 = std::min(bare, m_.forceScale);
+  const double tol = std::max(sol.newtonRelativeTolerance * r0, m_.absTolerance);
+  int maxOuter = sol.maxPressureIterations;
+  for (const auto& e : effects) maxOuter = std::max(maxOuter, e->maxAugmentations());
+  AndersonMixing mixing(sol.pressureAccelerationDepth, m_.comm);
+  Vector f(m_.u->getMap());
+  for (int it = 1; it <= maxOuter; ++it) {
+    // Later passes: down to round-off, 1e-3 x the absolute tolerance.
+    double tolIt = tol;
+    if (it > 1) {
+      assembly.evaluate(*m_.u, &f, nullptr);
+      tolIt = std::max(std::min(tol, kLaterPassReduction * f.norm2()), 1e-3 * m_.absTolerance);
+    }
+    const auto solveStart = Clock::now();
+    const NewtonResult r = m_.newton->solve(*m_.u, tolIt);
+    const double solveSeconds = since(solveStart);
+    rec.newton += r.iterations;
+    rec.linear += r.linearIterations;
+    rec.residual = r.residualNorm;
+    rec.augmentations = it;
+    if (log_.on("newton")) {
+      std::string text = "newton |R|:";
+      for (double n : r.residualHistory) text += format(" %.3e", n);
+      text += format("  (%d linear; preconditioners built: %d; %.3f s)", r.linearIterations,
+                     m_.newton->preconditionerBuilds(), solveSeconds);
+      std::vector<double> history(r.residualHistory.begin(), r.residualHistory.end());
+      if (log_.on("newton"))
+        log_.event("newton", text,
+                 eventOf("newton").add("pass", json::number(it)).add("residuals", json::array(history))
+                     .add("converged", r.converged ? "true" : "false")
+                     .add("linear_iterations", json::number(r.linearIterations))
+                     .add("preconditioners_built", json::number(m_.newton->preconditionerBuilds()))
+                     .add("seconds", json::number(solveSeconds)));
+    }
+    // A later pass may start below what round-off lets Newton reach; a state
+    // within the absolute tolerance is as converged as it gets.
+    if (!r.converged && !(it > 1 && r.residualNorm <= m_.absTolerance)) {
+      if (checkTangent_) checkTangent();
+      failure = r.failure;
+      return false;
+    }
+    // Refresh p(x), v, contact pressures at the converged state.
+    assembly.evaluate(*m_.u, &f, nullptr);
+    bool met = true, volumeMet = true;
+    std::vector<const Effect*> settled;  // plain-updated effects already within tolerance
+    for (const auto& e : effects) {
+      double v = 0;
+      Teuchos::reduceAll(*m_.comm, Teuchos::REDUCE_MAX, e->constraintViolation(), Teuchos::outArg(v));
+      if (e.get() == &assembly.bricks()) {
+        rec.volumeChange = v, volumeMet = v <= e->constraintTolerance();
+        if (m_.pressureStep) m_.pressureStep->measuredAfterNewton(v);
+      }
+      if (log_.on("newton"))
+        log_.event("newton", format("%s: %.3e (tolerance %.1e)", e->constraintName().c_str(), v, e->constraintTolerance()),
+                 eventOf("constraint").add("name", json::string(e->constraintName())).add("violation", json::number(v))
+                     .add("tolerance", json::number(e->constraintTolerance())));
+      if (v <= e->constraintTolerance()) {
+        if (m_.rolling) settled.push_back(e.get());
+        continue;
+      }
+      met = false;
+      if (e->maxAugmentations() > 0 && it >= e->maxAugmentations()) {
+        failure = e->constraintName() + " " + Teuchos::toString(v) + " above its tolerance " +
+                  Teuchos::toString(e->constraintTolerance()) + " after " + std::to_string(it) + " augmentations";
+        return false;
+      }
+    }
+    if (met) return true;
+    if (m_.pressureStep) {
+      // The other multipliers first: the pressure step then re-balances the
+      // body under their new values too, so their change does not spoil the
+      // volumes it makes exact.
+      const std::vector<double> pressureNext = multiplierMap(effects, true);  // at the converged state
+      setMultipliers(effects, multiplierMap(effects, false), false, settled);
+      if (!volumeMet && !saddlePointPressureStep(t, f, rec))  // no progress: a plain pass instead
+        setMultipliers(effects, pressureNext, true);
+      continue;
+    }
+    setMultipliers(effects, mixing.next(multipliers(effects, true), multiplierMap(effects, true)), true);
+    // Rolling: contact and friction multipliers within their tolerance stay
+    // put. Moving them anyway (points flicker at the tolerance level as they
+    // pass through the nip) keeps changing the map the pressure loop's mixing
+    // works on, and it stalls. Elsewhere every multiplier moves each pass (a
+    // symmetric problem then stays symmetric to round-off).
+    setMultipliers(effects, multiplierMap(effects, false), false, settled);
+  }
+  failure = "augmentation loop did not meet the volume and contact tolerances in " + std::to_string(maxOuter) +
+            " iterations";
+  return false;
+}
+
+bool AugmentationLoop::saddlePointPressureStep(double t, Vector& f, StepRecord& rec) {
+  auto& assembly = *m_.assembly;
+  BrickEffect& bricks = assembly.bricks();
+  auto W = m_.newton->matrix();
+  assembly.evaluate(*m_.u, &f, W.get());  // the tangent at the converged state
+  Vector dx(assembly.dofMap());
+  // Solved until the volume error predicted after the next Newton solve is a
+  // fraction of the volume tolerance (PressureStep::solve).
+  const double volumeTarget = kPressureStepVolumeMargin * bricks.constraintTolerance();
+  PressureStep::Result step;
+  const auto stepStart = Clock::now();
+  try {
+    step = m_.pressureStep->solve(*W, m_.newton->approximateInverse(), f, kPressureStepTolerance, volumeTarget,
+                                  m_.scene.solver.maxLinearIterations, dx, pressureStepDmu_);
+  } catch (const std::exception&) {  // e.g. a preconditioner that cannot be built: a plain pass
+    return false;
+  }
+  rec.linear += step.iterations;
+  rec.pressureStep += step.iterations;
+  if (log_.on("newton"))
+    log_.event("newton",
+             format("pressure step: %d GMRES iterations, residual reduced %.2e, volume error left %.2e "
+                    "(stopped on the prediction after Newton %.2e, target %.2e, %d checks), %d contact rows; %.3f s",
+                    step.iterations, step.reduction, step.volumeResidual, step.volumePredicted,
+                    step.predictionTarget, step.predictions, step.contactRows, since(stepStart)),
+             eventOf("pressure_step").add("iterations", json::number(step.iterations))
+                 .add("reduction", json::number(step.reduction))
+                 .add("volume_error", json::number(step.volumeResidual))
+                 .add("volume_predicted", json::number(step.volumePredicted))
+                 .add("prediction_target", json::number(step.predictionTarget))
+                 .add("predictions", json::number(step.predictions))
+                 .add("contact_rows", json::number(step.contactRows))
+                 .add("seconds", json::number(since(stepStart))));
+  if (!(step.reduction < 1)) return false;
+  m_.u->update(1.0, dx, 1.0);
+  assembly.applyConstraints(*m_.u, t);
+  // Each effect's multipliers move by their part of dmu (contact's back into
+  // lambda >= 0: a point the step pulls free is released).
+  for (size_t i = 0; i < assembly.effects().size(); ++i) {
+    Effect& e = *assembly.effects()[i];
+    auto mu = e.multipliers();
+    auto d = pressureStepDmu_[i];
+    if (mu.extent(0) == 0 || d.extent(0) != mu.extent(0)) continue;
+    Kokkos::parallel_for(
+        "pressure step multipliers", Kokkos::RangePolicy<ExecSpace>(0, mu.extent(0)),
+        KOKKOS_LAMBDA(int k) { mu(k) += d(k); });
+    e.projectMultipliers();
+  }
+  return true;
+}
+
+void AugmentationLoop::checkTangent() {
+  auto& assembly = *m_.assembly;
+  const auto map = m_.u->getMap();
+  Vector v(map), Wv(map), fp(map), fm(map), trial(map);
+  v.randomize();
+  {
+    auto d = v.getDataNonConst();
+    for (LO i = 0; i < LO(d.size()); ++i)
+      if (assembly.ownedConstrained(i)) d[i] = 0;
+  }
+  auto W = assembly.createMatrix();
+  assembly.evaluate(*m_.u, nullptr, W.get());
+  W->apply(v, Wv);
+  const double h = 1e-7;
+  trial.update(1.0, *m_.u, h, v, 0.0);
+  assembly.evaluate(trial, &fp, nullptr);
+  trial.update(1.0, *m_.u, -h, v, 0.0);
+  assembly.evaluate(trial, &fm, nullptr);
+  Vector diff(map);
+  diff.update(1.0 / (2 * h), fp, -1.0 / (2 * h), fm, 0.0);
+  diff.update(-1.0, Wv, 1.0);
+  const double error = diff.norm2(), scale = Wv.norm2();  // collective: every rank
+  const std::string text = format("tangent check: |W v - FD| / |W v| = %.3e (|W v| = %.3e)", error / scale, scale);
+  if (log_.on("newton"))
+    log_.event("newton", text, eventOf("tangent_check").add("relative_error", json::number(error / scale))
+                                   .add("norm", json::number(scale)));
+  else if (!log_.quiet())
+    std::printf("    %s\n", text.c_str());
+  assembly.evaluate(*m_.u, nullptr, nullptr);
+}
+
+}  // namespace capstan

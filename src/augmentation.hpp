@@ -1,0 +1,44 @@
+// The augmentation loop (formulation.md §1 and §2; docs/numerics.md, "The
+// pressure loop"): Newton at fixed multipliers (element pressure anchors,
+// contact and stick multipliers), then each effect's constraint is checked
+// and the multipliers move: by the saddle-point pressure step
+// (Solver/Pressure Update = Saddle Point) or to their fixed-point map,
+// Anderson-accelerated, until every constraint meets its tolerance.
+#pragma once
+
+#include <string>
+
+#include "anderson.hpp"
+#include "log.hpp"
+#include "model.hpp"
+#include "step_record.hpp"
+
+namespace capstan {
+
+class AugmentationLoop {
+ public:
+  // checkTangent: compare the assembled tangent with differences of the
+  // residual before each solve and after a failed one (--check-tangent).
+  AugmentationLoop(Model& model, Log& log, bool checkTangent);
+  // Solves the increment ending at t from the first guess in u. `bare`: the
+  // residual norm of the bare increment (Newton's tolerance is relative to
+  // it). Adds its iterations to rec. False with `failure` set if Newton or
+  // the loop failed (u and the multipliers are then the caller's to restore).
+  bool solve(double t, double bare, StepRecord& rec, std::string& failure);
+
+ private:
+  // The saddle-point step at the converged state (src/pressure_step.hpp):
+  // moves u and the multipliers together. False if the block solve made no
+  // progress (nothing is changed then).
+  bool saddlePointPressureStep(double t, Vector& f, StepRecord& rec);
+  // Debugging aid: the assembled tangent against a central difference of the
+  // residual along a random direction, logged (topic newton, or stdout).
+  void checkTangent();
+
+  Model& m_;
+  Log& log_;
+  bool checkTangent_;
+  std::vector<Kokkos::View<double*>> pressureStepDmu_;  // per effect: its multipliers' change in the step
+};
+
+}  // namespace capstan

@@ -1,0 +1,58 @@
+#include "contact_settings.hpp"
+
+namespace capstan {
+
+const std::vector<std::pair<const char*, ContactSettings::Method>> ContactSettings::methods = {
+    {"Penalty", Method::Penalty}, {"Augmented Lagrangian", Method::AugmentedLagrangian}};
+
+void ContactSettings::declare(Teuchos::ParameterList& contact) {
+  contact.set("Method", std::string("Penalty"), "Penalty | Augmented Lagrangian");
+  contact.set("Penalty", 1e-3, "eps2 > 0: penetration per unit contact pressure");
+  contact.set("Penetration Tolerance", 0.0,
+              "Multiplier loop (augmented Lagrangian, or a penalty solved at a larger penalty): "
+              "stop when the penetration (or its error against the penalty answer) is below "
+              "this; 0 = 1e-4 x the smallest candidate face edge");
+  contact.set("Max Augmentations", 50, "Augmented Lagrangian: most multiplier updates per step");
+  contact.set("Minimum Solve Penalty", -1.0,
+              "Newton solves use eps = max(Penalty, this), and multiplier updates then reach the "
+              "answer of Penalty (or exact contact): a well-conditioned solve for any Penalty. "
+              "< 0: automatic, 1e-2 h / c with the Nodal rule (h the smallest candidate face edge), "
+              "off with Gauss rules; 0: off");
+  contact.set("Quadrature", std::string("Auto"),
+              "Contact points per face: Auto | Gauss 2x2 | Gauss 3x3 | Nodal (at the face's nodes). "
+              "Auto: Gauss 2x2 for Penalty, Nodal for Augmented Lagrangian (exact contact at every "
+              "Gauss point of flat faces on a curved capstan over-constrains the body)");
+  contact.set("Smoothing", 0.0,
+              "Pressure scale eta >= 0 of a smoothed contact law: t_n = (tn + sqrt(tn^2 + eta^2)) / 2 "
+              "instead of max(0, tn), at most eta/2 different. Removes the corner where points enter "
+              "and leave contact, at which Newton stalls in rolling contact; 0 = the exact max");
+}
+
+ContactSettings ContactSettings::parse(const Teuchos::ParameterList& ct, const std::string& path,
+                                       const ParameterReader& r) {
+  ContactSettings s;
+  s.method = r.choice(ct, path, "Method", methods);
+  s.penalty = r.positive(ct, path, "Penalty");
+  s.penetrationTolerance = r.nonNegative(ct, path, "Penetration Tolerance");
+  s.minimumSolvePenalty = r.finite(ct, path, "Minimum Solve Penalty");
+  enum class Rule { Auto, Gauss2x2, Gauss3x3, Nodal };
+  const Rule rule = r.choice(ct, path, "Quadrature",
+                             std::vector<std::pair<const char*, Rule>>{{"Auto", Rule::Auto},
+                                                                       {"Gauss 2x2", Rule::Gauss2x2},
+                                                                       {"Gauss 3x3", Rule::Gauss3x3},
+                                                                       {"Nodal", Rule::Nodal}});
+  s.quadrature = rule == Rule::Gauss2x2   ? Quadrature::Gauss2x2
+                 : rule == Rule::Gauss3x3 ? Quadrature::Gauss3x3
+                 : rule == Rule::Nodal    ? Quadrature::Nodal
+                 : s.exact()              ? Quadrature::Nodal
+                                          : Quadrature::Gauss2x2;
+  if (s.exact() && s.quadrature != Quadrature::Nodal)
+    r.fail(path + "/Quadrature",
+           "the Augmented Lagrangian needs Nodal (or Auto): zero gap at every Gauss point of flat "
+           "faces against a curved capstan is impossible, and the multipliers would never settle");
+  s.smoothing = r.nonNegative(ct, path, "Smoothing");
+  s.maxAugmentations = r.atLeast(ct, path, "Max Augmentations", 1);
+  return s;
+}
+
+}  // namespace capstan

@@ -1,0 +1,184 @@
+// Physical effects: each is a small object the scene switches on, owning its
+// data and launching its Kokkos kernel over its entities (bricks or faces). All
+// of them hand the same things to the one assembly path: per-entity dof ids and
+// residuals (LocalSystem), and each entity's tangent to the assembly's
+// TangentSink as it is formed. One file per effect in src/effects/;
+// src/effects/factory.hpp builds those a scene names.
+#pragma once
+
+#include <Kokkos_Core.hpp>
+#include <Teuchos_Comm.hpp>
+
+#include <array>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+namespace capstan {
+
+struct Mesh;
+
+using ExecSpace = Kokkos::DefaultExecutionSpace;
+// Row-major per entity, so a kernel works on contiguous element data.
+using IntMatrix = Kokkos::View<int**, Kokkos::LayoutRight>;
+using Matrix = Kokkos::View<double**, Kokkos::LayoutRight>;
+using Tensor3 = Kokkos::View<double***, Kokkos::LayoutRight>;
+using NodalVectors = Kokkos::View<double* [3], Kokkos::LayoutRight>;
+
+struct LocalSystem {
+  IntMatrix dofs;  // [entity][k]: overlapped dof ids (3 * node + component)
+  Matrix R;        // [entity][k]
+  bool stiff = false;  // whether the entities have a tangent (dead loads have none)
+  // Optional: entities with active(e) == 0 contribute nothing this evaluation
+  // (contact faces away from the capstan); empty = all active. The matrix
+  // graph still holds them, so the sparsity pattern never changes.
+  Kokkos::View<int*> active;
+};
+
+// An effect's active flags on the host (empty: every entity is active).
+inline Kokkos::View<int*>::HostMirror activeOnHost(const LocalSystem& L) {
+  return Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.active);
+}
+
+// What a kernel does with an active entity's tangent K_e (n x n, row-major,
+// dof 3a+i) right after forming it, while it is still in cache. Element
+// tangents are not stored: on G1 8x on one rank they took 790 MB, and the run's
+// peak fell 18% without them (docs/performance.md, "Assembly without stored
+// element tangents"). Each part is off when empty:
+//   - values: K_e is added into the local CRS values of Newton's matrix (owned
+//     plus shared rows) at offsets found once: rowBlock(e, k * n/3 + b) is the
+//     offset of column 3b in row k (its 3 columns follow it), -1 where row k
+//     is held; bit l of heldColumns(e) set: column l is held, not added;
+//   - z, Kz: Kz(e, k) = sum_l K_e(k, l) z(e, l), the step predictor's K z;
+//   - keepSlot, kept: a copy of K_e in kept(keepSlot(e)) where keepSlot(e) >= 0
+//     (entities with a rigid core's face node, for the chain rule).
+struct TangentSink {
+  Kokkos::View<double*> values;
+  Kokkos::View<int**, Kokkos::LayoutRight> rowBlock;
+  Kokkos::View<int*> heldColumns;
+  Matrix z, Kz;
+  Kokkos::View<int*> keepSlot;
+  Kokkos::View<double***, Kokkos::LayoutRight> kept;
+
+  // Entity e's tangent K (n x n): into the matrix, K z and the kept copy.
+  template <int n>
+  KOKKOS_INLINE_FUNCTION void take(int e, const double* K) const {
+    if (values.extent(0)) {
+      // On one thread (Serial) a plain add: there an atomic add of a double is
+      // a compare-and-swap loop for nothing.
+      constexpr bool serial = std::is_same_v<Kokkos::DefaultExecutionSpace, Kokkos::Serial>;
+      constexpr int nb = n / 3;
+      double* const v = values.data();
+      const int* const rows = &rowBlock(e, 0);
+      const int held = heldColumns(e);
+      for (int k = 0; k < n; ++k) {
+        const int* const o = rows + k * nb;
+        if (o[0] < 0) continue;  // a held row
+        const double* const Kk = K + k * n;
+        for (int b = 0; b < nb; ++b)
+          for (int j = 0; j < 3; ++j) {
+            if (held && (held & (1 << (3 * b + j)))) continue;
+            if constexpr (serial) v[o[b] + j] += Kk[3 * b + j];
+            else Kokkos::atomic_add(&v[o[b] + j], Kk[3 * b + j]);
+          }
+      }
+    }
+    if (z.extent(0))
+      for (int k = 0; k < n; ++k) {
+        double s = 0;
+        for (int l = 0; l < n; ++l) s += K[k * n + l] * z(e, l);
+        Kz(e, k) = s;
+      }
+    if (keepSlot.extent(0) && keepSlot(e) >= 0)
+      for (int k = 0; k < n; ++k)
+        for (int l = 0; l < n; ++l) kept(keepSlot(e), k, l) = K[k * n + l];
+  }
+};
+
+// An effect's constraints, linearised at the last evaluation, for the
+// saddle-point step (src/pressure_step.hpp), which solves for the position
+// change and the multipliers' changes together. Row j, multiplier mu_j:
+//     c_j(x + dx, mu_j + dmu_j) ~ c_j + gradient_j . dx + diagonal_j dmu_j = 0,
+//     dR / dmu_j = force_j gradient_j,
+// and schur_j approximates the Schur complement's diagonal
+// diagonal_j - force_j gradient_j^T K^-1 gradient_j: Newton's K holds each
+// constraint's penalty, which makes that diagonal approximation good.
+struct ConstraintRows {
+  std::vector<int> entity;      // row j's entity (its dofs: local().dofs(entity_j, .))
+  std::vector<int> multiplier;  // mu_j's index in multipliers()
+  Matrix gradient;              // [j][k]: d c_j / d x over the entity's dofs
+  std::vector<double> force, diagonal, value, schur;
+  // c_j's unit for the step's stop rule (|c_j| / scale_j against a relative
+  // tolerance), or 0: the stop rule does not look at row j.
+  std::vector<double> scale;
+  size_t size() const { return entity.size(); }
+  void clear() { entity.clear(), multiplier.clear(), force.clear(), diagonal.clear(), value.clear(), schur.clear(), scale.clear(); }
+};
+
+struct StepRecord;
+
+class Effect {
+ public:
+  explicit Effect(std::string name) : name_(std::move(name)) {}
+  virtual ~Effect() = default;
+  const std::string& name() const { return name_; }
+  // Residual at current positions x and displacements u (overlapped nodes),
+  // and with a sink the tangent, which goes to the sink entity by entity.
+  void evaluate(const NodalVectors& x, const NodalVectors& u, const TangentSink* sink);
+  const LocalSystem& local() const { return local_; }
+  long launches() const { return launches_; }
+  double seconds() const { return seconds_; }
+
+  // The load increment being solved, from tStart (the last converged state) to
+  // tEnd: effects that move with time (capstans) evaluate at tEnd.
+  virtual void setInterval(double /*tStart*/, double /*tEnd*/) {}
+
+  // Augmentation, the outer loop around each Newton solve (element pressure
+  // anchors, contact multipliers): the multipliers are held fixed in a Newton
+  // solve; after it converges they move to their fixed-point map G, until each
+  // effect's constraint violation is within its tolerance. Effects without
+  // multipliers return an empty view.
+  virtual Kokkos::View<double*> multipliers() { return {}; }
+  // G(multipliers) at the last evaluation, into `next` (same size).
+  virtual void multiplierMap(const Kokkos::View<double*>& /*next*/) const {}
+  // History: state from the last converged increment (friction's positions and
+  // stick tractions), changed only by commit(x) when an increment converges, at
+  // its converged positions x (the last evaluation).
+  virtual Kokkos::View<double*> history() { return {}; }
+  virtual void commit(const NodalVectors& /*x*/) {}
+
+  // The step predictor's evaluations: effects may use a simpler, more robust
+  // linearisation there (it is only a first guess; Newton's tangent is exact).
+  virtual void setPredicting(bool /*on*/) {}
+
+  // Whether Anderson mixing may accelerate this effect's multiplier loop.
+  virtual bool accelerated() const { return true; }
+  // Brings mixed multipliers back into their admissible set (e.g. lambda >= 0).
+  virtual void projectMultipliers() {}
+  // This rank's rows for the saddle-point step, at positions x (the last
+  // evaluation's); none by default (a plain multiplier update).
+  virtual void constraintRows(const NodalVectors& /*x*/, ConstraintRows& rows) const { rows.clear(); }
+  // Largest violation of the constraint on this rank at the last evaluation,
+  // and the tolerance it must meet (same units).
+  virtual double constraintViolation() const { return 0; }
+  virtual double constraintTolerance() const { return 0; }
+  virtual std::string constraintName() const { return name(); }
+  // The most multiplier updates per load step before the step fails; 0: the
+  // augmentation loop's own limit (Solver/Max Pressure Iterations).
+  virtual int maxAugmentations() const { return 0; }
+  // Adds its figures at the last evaluation to a converged step's record
+  // (src/step_record.hpp). Collective: every rank calls it.
+  virtual void report(const Teuchos::Comm<int>& /*comm*/, StepRecord& /*rec*/) const {}
+
+ protected:
+  // tangent: whether to form the tangent and hand it to sink.
+  virtual void launch(const NodalVectors& x, const NodalVectors& u, bool tangent, const TangentSink& sink) = 0;
+  LocalSystem local_;
+
+ private:
+  std::string name_;
+  long launches_ = 0;
+  double seconds_ = 0;
+};
+
+}  // namespace capstan

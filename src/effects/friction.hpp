@@ -1,0 +1,75 @@
+#pragma once
+
+#include "contact.hpp"
+
+#include "../../kernels/friction.hpp"
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace capstan {
+
+// Friction of one capstan on its contact faces (kernels/friction.hpp); reads
+// the normal contact state of its ContactEffect (same faces, same points).
+class FrictionEffect : public Effect {
+ public:
+  FrictionEffect(const std::string& name, const Mesh& mesh, const std::vector<int>& quads,
+                 const ContactEffect& contact, const FrictionSettings& settings);
+
+  void setInterval(double tStart, double tEnd) override;
+  // Predictor: every contact point sticks (kernels/friction.hpp).
+  void setPredicting(bool on) override { parameters_.stickPredictor = on; }
+  Kokkos::View<double*> history() override { return history_; }
+  void commit(const NodalVectors& x) override;
+
+  // Coulomb with the augmented Lagrangian contact: a tangential multiplier per
+  // point replaces last step's traction in the trial traction and is updated
+  // to the traction after each converged solve (Uzawa), so sticking points
+  // stick exactly (no elastic slip of size eps_t t) whatever the tangential
+  // penalty. Violation: eps_t |t - lambda_T|, the slip of a sticking point.
+  bool augmented() const {
+    return settings_.law == FrictionSettings::Law::Coulomb && contact_.settings().exact();
+  }
+  Kokkos::View<double*> multipliers() override {
+    return augmented() ? tangentialMultipliers_ : Kokkos::View<double*>();
+  }
+  void multiplierMap(const Kokkos::View<double*>& next) const override;
+  bool accelerated() const override { return false; }
+  double constraintViolation() const override;
+  double constraintTolerance() const override { return contact_.constraintTolerance(); }
+  std::string constraintName() const override { return name() + " stick slip"; }
+  // Adds friction to its capstan's record (reported by the contact before it).
+  void report(const Teuchos::Comm<int>& comm, StepRecord& rec) const override;
+
+  struct Figures {
+    std::array<double, 3> force{};  // friction of the body on the capstan
+    double torque = 0;              // about the capstan's axis
+    long stick = 0, slip = 0;
+    double frictionIntegral = 0;    // sum of w |t_f|
+    double normalIntegral = 0;      // sum of w t_n
+    double maxRatio = 0;            // largest |t_f| / (mu t_n)
+  };
+  Figures figures() const;
+  // Per face: mean friction traction (3), stick and slip point counts.
+  void faceFields(std::vector<double>& traction, std::vector<double>& stick,
+                  std::vector<double>& slip) const;
+
+ protected:
+  void launch(const NodalVectors& x, const NodalVectors& u, bool tangent, const TangentSink& sink) override;
+
+ private:
+  const ContactEffect& contact_;
+  Kokkos::View<int* [4], Kokkos::LayoutRight> nodes_;
+  Kokkos::View<double* [4][3], Kokkos::LayoutRight> X_;
+  // [face][0..11]: node positions at the last converged state; then
+  // [face][12 + 3q + i]: Coulomb's traction at point q from that state.
+  Kokkos::View<double*> history_;
+  Kokkos::View<double*> tangentialMultipliers_;  // [(face * kMaxFacePoints + q) * 3 + i]
+  // Per face and point at the last evaluation: traction (3), t_n, slip, state, weight, e (3).
+  Kokkos::View<double** [10], Kokkos::LayoutRight> points_;
+  FrictionSettings settings_;
+  kernels::FrictionParameters parameters_;
+};
+
+}  // namespace capstan

@@ -1,0 +1,73 @@
+#include "load_stepper.hpp"
+
+#include "effect_state.hpp"
+#include "rolling.hpp"
+
+namespace capstan {
+
+namespace {
+// The smallest sub-step, as a fraction of Time/Step Size: ten halvings.
+constexpr double kMinimumSubstep = 1.0 / 1024;
+}  // namespace
+
+LoadStepper::LoadStepper(Model& model, Log& log, bool checkTangent, double tDone)
+    : m_(model), log_(log), predictors_(model, log), augmentation_(model, log, checkTangent), tDone_(tDone) {}
+
+bool LoadStepper::solveIncrement(double t0, double t1, StepRecord& rec, std::string& failure) {
+  m_.assembly->setInterval(t0, t1);
+  const double bare = predictors_.firstGuess(t0, t1, rec);
+  return augmentation_.solve(t1, bare, rec, failure);
+}
+
+bool LoadStepper::advance(StepRecord& rec, std::string& failure) {
+  auto& assembly = *m_.assembly;
+  const auto& effects = assembly.effects();
+  const double dt = m_.scene.stepSize;
+  // A reused preconditioner starts each step afresh, so a run restarted at
+  // any step repeats the uninterrupted run's arithmetic exactly.
+  m_.newton->rebuildPreconditioner();
+  double h = rec.time - tDone_;
+  // The step's start: a failed step's converged sub-steps are not outputs.
+  Vector uStep(*m_.u, Teuchos::Copy);
+  const auto stateStep = saveState(effects);
+  const double tStep = tDone_;
+  while (tDone_ < rec.time - 1e-12 * dt) {
+    const double tEnd = std::min(tDone_ + h, rec.time);
+    Vector uSaved(*m_.u, Teuchos::Copy);
+    const auto stateSaved = saveState(effects);
+    std::vector<double> rotationsSaved;
+    for (const auto& core : assembly.rigidCores()) rotationsSaved.push_back(core.rotation);
+    std::string why;
+    if (solveIncrement(tDone_, tEnd, rec, why)) {
+      predictors_.remember(uSaved, tDone_, rotationsSaved);
+      tDone_ = tEnd;
+      // History (friction) moves on to this converged state; the step's
+      // last sub-step commits after the step's figures are taken, which
+      // belong to the increment that just converged.
+      if (tDone_ < rec.time - 1e-12 * dt)
+        for (const auto& e : effects) e->commit(assembly.positions());
+      h = std::min(2 * h, rec.time - tDone_);
+      continue;
+    }
+    m_.u->update(1.0, uSaved, 0.0);
+    restoreState(effects, stateSaved);
+    ++rec.cutbacks;
+    h /= 2;
+    log_.progress(format("  step %d: cut back to dt = %.4g (%s)", rec.step, h, why.c_str()));
+    if (h < dt * kMinimumSubstep) {
+      failure = "step " + std::to_string(rec.step) + " failed at minimum step size " +
+                Teuchos::toString(dt * kMinimumSubstep) + ": " + why + brakeDiagnosis(m_.scene);
+      m_.u->update(1.0, uStep, 0.0);
+      restoreState(effects, stateStep);
+      tDone_ = tStep;
+      assembly.setInterval(tDone_, tDone_);
+      return false;
+    }
+  }
+  assembly.applyConstraints(*m_.u, tDone_);  // rigid cores' face nodes where the cores are
+  Vector f(m_.u->getMap());
+  assembly.evaluate(*m_.u, &f, nullptr);  // reactions at the converged state
+  return true;
+}
+
+}  // namespace capstan

@@ -1,0 +1,38 @@
+// The load-step controller: each step from the last converged time to the
+// step's time, in sub-steps that halve on failure and grow back after
+// success; a failed increment puts u, the multipliers and the effects'
+// history back as they were.
+#pragma once
+
+#include <string>
+
+#include "augmentation.hpp"
+#include "log.hpp"
+#include "model.hpp"
+#include "predictors.hpp"
+#include "step_record.hpp"
+
+namespace capstan {
+
+class LoadStepper {
+ public:
+  // tDone: the time of the converged state in u (a restart's).
+  LoadStepper(Model& model, Log& log, bool checkTangent, double tDone);
+  // Advances to rec.time = rec.step * Time/Step Size, adding the iterations and
+  // cuts to rec. True: u holds the converged state, evaluated there (the
+  // figures and reactions). False, with `failure`: no equilibrium even at the
+  // smallest sub-step; u and the effects are back at the step's start.
+  bool advance(StepRecord& rec, std::string& failure);
+  double time() const { return tDone_; }
+
+ private:
+  bool solveIncrement(double t0, double t1, StepRecord& rec, std::string& failure);
+
+  Model& m_;
+  Log& log_;
+  Predictors predictors_;
+  AugmentationLoop augmentation_;
+  double tDone_;
+};
+
+}  // namespace capstan

@@ -1,0 +1,133 @@
+#include "predictors.hpp"
+
+#include <algorithm>
+
+#include "rolling.hpp"
+
+namespace capstan {
+
+double Predictors::firstGuess(double t0, double t, StepRecord& rec) {
+  auto& assembly = *m_.assembly;
+  Vector f(m_.u->getMap());
+  double bare = 0;
+  {
+    Vector plain(*m_.u, Teuchos::Copy);
+    assembly.applyConstraints(plain, t);
+    assembly.evaluate(plain, &f, nullptr);
+    bare = f.norm2();
+  }
+  // In steady rolling every increment looks like the one before (the nip has
+  // moved on by one increment of the roller's turn), which the linear response
+  // from a state at rest cannot see.
+  bool extrapolated = m_.rolling && previous_ && tPrevious_ < t0 && extrapolate(t0, t, bare, f);
+  // From the bare state every point of a driven roller's nip slips and the
+  // core's rotation has almost no stiffness: turn the body with the core first.
+  bool rolled = !extrapolated && rollWithCores(t0, t);
+  // A step that barely changes anything (steady rolling) needs no predictor.
+  if (!extrapolated && !rolled && m_.scene.solver.predictor == SolverSettings::Predictor::Tangent &&
+      bare > 1e-8 * m_.forceScale)
+    tangent(t0, t, bare, rec);
+  assembly.applyConstraints(*m_.u, t);
+  return bare;
+}
+
+void Predictors::remember(const Vector& before, double tBefore, std::vector<double> rotationsBefore) {
+  previous_ = rcp(new Vector(before, Teuchos::Copy));
+  tPrevious_ = tBefore;
+  previousRotation_ = std::move(rotationsBefore);
+}
+
+bool Predictors::extrapolate(double t0, double t, double bare, Vector& f) {
+  Vector trial(*m_.u, Teuchos::Copy);
+  trial.update(-(t - t0) / (t0 - tPrevious_), *previous_, 1.0 + (t - t0) / (t0 - tPrevious_));
+  m_.assembly->applyConstraints(trial, t);
+  const bool valid = m_.assembly->evaluate(trial, &f, nullptr);
+  const double norm = f.norm2();  // collective: every rank
+  if (log_.on("newton"))
+    log_.event("newton", format("extrapolated: valid %d |R| %.3e bare %.3e", int(valid), norm, bare),
+             json::Object().add("event", json::string("extrapolation")).add("valid", valid ? "true" : "false")
+                 .add("residual", json::number(norm)).add("bare", json::number(bare)));
+  if (!(valid && norm < bare)) return false;
+  m_.u->update(1.0, trial, 0.0);
+  return true;
+}
+
+bool Predictors::rollWithCores(double t0, double t) {
+  const auto& cores = m_.assembly->rigidCores();
+  std::vector<double> dTheta;
+  for (size_t i = 0; i < cores.size(); ++i) {
+    double omega = 0;
+    if (cores[i].free[3]) {
+      if (previous_ && tPrevious_ < t0)
+        omega = (cores[i].rotation - previousRotation_[i]) / (t0 - tPrevious_);
+      else
+        omega = noSlipAngularVelocity(m_.scene, cores[i]);
+    }
+    dTheta.push_back(omega * (t - t0));
+  }
+  if (std::none_of(dTheta.begin(), dTheta.end(), [](double x) { return x != 0; })) return false;
+  m_.assembly->rollWithCores(*m_.u, dTheta);
+  if (log_.on("newton"))
+    log_.event("newton", format("rolled by %.4g", dTheta[0]),
+             json::Object().add("event", json::string("rolled")).add("angle", json::number(dTheta[0])));
+  return true;
+}
+
+// Starting Newton from the linear response (rather than with the increment
+// alone on the boundary, where the boundary layer of elements is badly
+// distorted) saves most line-search work.
+void Predictors::tangent(double t0, double t1, double bare, StepRecord& rec) {
+  auto& assembly = *m_.assembly;
+  const auto map = m_.u->getMap();
+  Vector z(map), Kz(map), f(map), rhs(map), du(map);
+  assembly.constraintIncrement(z, t0, t1);
+  // Into Newton's matrix (Newton reassembles it before it solves): a matrix of
+  // the predictor's own would cost memory (docs/performance.md).
+  const RCP<FEMatrix> W = m_.newton->matrix();
+  // Effects linearise for the predictor: the bare state penetrates the
+  // capstans by the whole increment (contact leaves out its geometric
+  // stiffness, t_n / d, large there) and slides over them by the capstan's
+  // whole travel (friction assumes stick: the body follows the capstan, which
+  // a slipping linearisation, with no stiffness along the slip, cannot see).
+  for (const auto& e : assembly.effects()) e->setPredicting(true);
+  const bool valid = assembly.evaluate(*m_.u, &f, W.get(), &z, &Kz);
+  if (!valid) {
+    for (const auto& e : assembly.effects()) e->setPredicting(false);
+    return;
+  }
+  {
+    auto r = rhs.getDataNonConst();
+    auto fd = f.getData();
+    auto kz = Kz.getData();
+    for (LO d = 0; d < LO(r.size()); ++d) r[d] = assembly.ownedConstrained(d) ? 0.0 : -(fd[d] + kz[d]);
+  }
+  // A first guess: 1e-6 is plenty (Newton corrects it); a tighter tolerance
+  // on a nearly steady step, where the right-hand side is at round-off, ran
+  // GMRES to its limit.
+  const int its = m_.newton->linearSolve(rhs, du, std::max(1e-6, m_.scene.solver.linearTolerance));
+  for (const auto& e : assembly.effects()) e->setPredicting(false);
+  if (its < 0) return;  // keep the plain guess
+  rec.linear += its;
+  // The linear response can overshoot where contact or large strain makes the
+  // problem strongly nonlinear (an element inverts, or the residual grows):
+  // then try shorter steps along du before keeping the plain guess.
+  for (double alpha = 1; alpha > 0.1; alpha /= 2) {
+    Vector trial(*m_.u, Teuchos::Copy);
+    trial.update(alpha, du, 1.0, z, 1.0);
+    assembly.applyConstraints(trial, t1);
+    const bool valid = assembly.evaluate(trial, &f, nullptr);
+    const double norm = f.norm2();  // collective: every rank
+    if (log_.on("newton"))
+      log_.event("newton", format("predictor alpha %g valid %d |R| %.3e bare %.3e", alpha, int(valid), norm, bare),
+               json::Object().add("event", json::string("predictor")).add("alpha", json::number(alpha))
+                   .add("valid", valid ? "true" : "false").add("residual", json::number(norm))
+                   .add("bare", json::number(bare)));
+    if (!valid) continue;  // inverts an element
+    if (norm < bare) {
+      m_.u->update(1.0, trial, 0.0);
+      return;
+    }
+  }
+}
+
+}  // namespace capstan

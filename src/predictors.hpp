@@ -1,0 +1,45 @@
+// First guesses for a load increment's Newton solve (docs/numerics.md,
+// "Predictors"): the tangent predictor, and for a rolling body (a rigid core
+// turning freely) the extrapolation along the last increment and the rigid
+// roll with the cores.
+#pragma once
+
+#include <vector>
+
+#include "log.hpp"
+#include "model.hpp"
+#include "step_record.hpp"
+
+namespace capstan {
+
+class Predictors {
+ public:
+  Predictors(Model& model, Log& log) : m_(model), log_(log) {}
+  // Moves u from the converged state at t0 to a first guess of the state at
+  // t1 (constraints applied at t1). Returns the residual norm of the bare
+  // increment (u with only the prescribed values moved): a guess is kept only
+  // where it beats it, and Newton's tolerance is relative to it. The
+  // predictor's Krylov iterations count in rec.
+  double firstGuess(double t0, double t1, StepRecord& rec);
+  // The state before the increment that just converged (u, its time and the
+  // cores' rotations): the base of the rolling extrapolation.
+  void remember(const Vector& before, double tBefore, std::vector<double> rotationsBefore);
+
+ private:
+  // Rolling: u extrapolated along the last converged increment; true if kept.
+  bool extrapolate(double t0, double t1, double bare, Vector& f);
+  // Rolling: the body turned with each free core at its last angular velocity
+  // (at first: rolling without slip); true if any core turned.
+  bool rollWithCores(double t0, double t1);
+  // K_ff du = -(R + K z)_f from the converged state and the prescribed
+  // increment z; kept if it beats the bare increment.
+  void tangent(double t0, double t1, double bare, StepRecord& rec);
+
+  Model& m_;
+  Log& log_;
+  RCP<Vector> previous_;  // the state before the last converged increment
+  double tPrevious_ = 0;
+  std::vector<double> previousRotation_;  // the cores' rotations in that state
+};
+
+}  // namespace capstan

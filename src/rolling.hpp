@@ -1,0 +1,24 @@
+// What a rolling scene (an annulus on a rigid core, driven by a spinning
+// capstan) needs beyond the effects: the no-slip reference speed and why a
+// braked roller may have no equilibrium.
+#pragma once
+
+#include <string>
+
+#include "scene.hpp"
+
+namespace capstan {
+
+struct RigidCore;
+
+// The core's angular velocity when its outer (undeformed) surface rolls
+// without slip on the first spinning capstan (external contact: it turns
+// against the capstan); 0 when there is none. The speed ratio is the core's
+// angular velocity over this.
+double noSlipAngularVelocity(const Scene& scene, const RigidCore& core);
+
+// Why a step may have no equilibrium at all: a core's applied torque beyond
+// what friction in the nip can carry ("; support ...: ..."), or empty.
+std::string brakeDiagnosis(const Scene& scene);
+
+}  // namespace capstan

@@ -1,0 +1,124 @@
+#include "solver_settings.hpp"
+
+namespace capstan {
+
+using Teuchos::ParameterList;
+using S = SolverSettings;
+
+const std::vector<std::pair<const char*, S::LinearSolver>> S::linearSolvers = {
+    {"Auto", LinearSolver::Auto}, {"GMRES", LinearSolver::GMRES}, {"CG", LinearSolver::CG}, {"Direct", LinearSolver::Direct}};
+const std::vector<std::pair<const char*, S::LineSearch>> S::lineSearches = {
+    {"Backtrack", LineSearch::Backtrack}, {"Polynomial", LineSearch::Polynomial}, {"Full Step", LineSearch::FullStep}};
+
+void SolverSettings::declare(ParameterList& sol) {
+  sol.set("Linear Solver", std::string("Auto"),
+          "Auto | GMRES | CG | Direct (Belos GMRES, Belos CG, Amesos2 KLU2). Auto: Direct up to "
+          "Direct Solver Max Dofs on one rank, GMRES otherwise");
+  sol.set("Direct Solver Max Dofs", 5000, "Auto: largest problem solved directly");
+  sol.set("Preconditioner", std::string("Auto"),
+          "Auto | ILU | Jacobi | MueLu | None (Ifpack2 RILUK per rank, Jacobi relaxation; MueLu smoothed "
+          "aggregation with the rigid-body modes). Auto: MueLu from 1000 dofs, ILU below");
+  sol.set("ILU Level", 1, "ILU: level of fill (>= 0)");
+  sol.set("Preconditioner Reuse", std::string("Adaptive"),
+          "Adaptive | None. Adaptive: Newton builds its preconditioner at each load step's start "
+          "and keeps it across iterations and pressure passes, rebuilding it when a Krylov solve "
+          "needs more than twice the iterations (+10) of the first solve after the last build, or "
+          "hits its limit; None: a new one every Newton iteration");
+  sol.set("Linear Tolerance", 1e-10, "Relative residual of each linear solve (0 < tol < 1)");
+  sol.set("Linear Tolerance Method", std::string("Adaptive"),
+          "Adaptive | Fixed. Adaptive: Eisenstat-Walker forcing terms (each Krylov solve only as "
+          "tight as Newton's progress needs, never tighter than Linear Tolerance); Fixed: every "
+          "Krylov solve to Linear Tolerance. Direct solves are exact either way");
+  sol.set("Max Linear Iterations", 2000, "Krylov iteration limit per linear solve");
+  sol.set("Newton Relative Tolerance", 1e-10, "Converged when |R| <= this x |R| at the step's start");
+  sol.set("Newton Absolute Tolerance", 0.0, "Converged when |R| <= this; 0 = 1e-13 x c x (body size)^2");
+  sol.set("Max Newton Iterations", 30, "Newton iteration limit per solve");
+  sol.set("Predictor", std::string("Tangent"),
+          "Tangent (linear response to the step's prescribed increment, from the previous "
+          "step) | Previous (the previous step's solution with the new boundary values)");
+  sol.set("Line Search", std::string("Backtrack"), "Backtrack | Polynomial | Full Step (NOX line search)");
+  sol.set("Volume Tolerance", 1e-10, "Pressure loop ends when max |v_e/V_e - 1| is below this");
+  sol.set("Max Pressure Iterations", 100, "Most pressure-anchor updates per step");
+  sol.set("Pressure Update", std::string("Auto"),
+          "How the pressure loop moves the element pressure anchors after each Newton solve: "
+          "Saddle Point (positions, anchors and exact contact's multipliers from one block Krylov solve, "
+          "v_e = V_e and g = 0 to first order), "
+          "Anderson (pbar <- p(x), Anderson-accelerated), or Auto (Saddle Point without friction, "
+          "Anderson with it)");
+  sol.set("Pressure Step Schur", std::string("Auto"),
+          "The saddle-point step's approximation of its volume rows' Schur complement: Laplacian "
+          "((eps V)^-1 + 0.15 L^-1, L = G^T diag(K0)^-1 G by 30 CG iterations: it holds Q1P0's nearly "
+          "spurious pressure modes), Diagonal ((eps V)^-1 alone), or Auto (Laplacian with Krylov "
+          "linear solves, Diagonal with a direct solver, whose exact K^-1 leaves it little to gain). "
+          "The same answer either way");
+  sol.set("Pressure Acceleration Depth", 5,
+          "Anderson acceleration depth of the pressure loop (0 = plain pbar <- p(x))");
+  sol.set("Minimum Solve Penalty", -1.0,
+          "Smallest eps1 x c used in the Newton solves: below it the condensed pressure "
+          "cannot be evaluated in double precision; the pressure loop still makes v_e = V_e exact. "
+          "-1: automatic, 3e-2 with the Saddle Point pressure update, 1e-2 with Anderson");
+  sol.sublist("NOX", false, "Passed to NOX unchanged, over capstan's defaults");
+  sol.sublist("Stratimikos", false, "Passed to Stratimikos unchanged, over capstan's defaults");
+}
+
+SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterReader& r, bool friction) {
+  const std::string at = "Solver";
+  SolverSettings s;
+  s.linearSolver = r.choice(sol, at, "Linear Solver", linearSolvers);
+  s.directSolverMaxDofs = sol.get<int>("Direct Solver Max Dofs");
+  s.preconditioner = r.choice(sol, at, "Preconditioner",
+                              std::vector<std::pair<const char*, Preconditioner>>{
+                                  {"Auto", Preconditioner::Auto}, {"ILU", Preconditioner::ILU},
+                                  {"Jacobi", Preconditioner::Jacobi}, {"MueLu", Preconditioner::MueLu},
+                                  {"None", Preconditioner::None}});
+  s.iluLevel = r.atLeast(sol, at, "ILU Level", 0);
+  s.preconditionerReuse = r.choice(sol, at, "Preconditioner Reuse",
+                                   std::vector<std::pair<const char*, Reuse>>{{"Adaptive", Reuse::Adaptive},
+                                                                              {"None", Reuse::None}});
+  s.linearTolerance = r.fraction(sol, at, "Linear Tolerance");
+  s.linearToleranceMethod = r.choice(sol, at, "Linear Tolerance Method",
+                                     std::vector<std::pair<const char*, ToleranceMethod>>{
+                                         {"Adaptive", ToleranceMethod::Adaptive}, {"Fixed", ToleranceMethod::Fixed}});
+  s.maxLinearIterations = r.atLeast(sol, at, "Max Linear Iterations", 1);
+  s.newtonRelativeTolerance = r.fraction(sol, at, "Newton Relative Tolerance");
+  s.newtonAbsoluteTolerance = sol.get<double>("Newton Absolute Tolerance");
+  if (!(s.newtonAbsoluteTolerance >= 0)) r.fail("Solver/Newton Absolute Tolerance", "must be >= 0");
+  s.maxNewtonIterations = r.atLeast(sol, at, "Max Newton Iterations", 1);
+  s.predictor = r.choice(sol, at, "Predictor",
+                         std::vector<std::pair<const char*, Predictor>>{{"Tangent", Predictor::Tangent},
+                                                                        {"Previous", Predictor::Previous}});
+  s.lineSearch = r.choice(sol, at, "Line Search", lineSearches);
+  s.volumeTolerance = r.fraction(sol, at, "Volume Tolerance");
+  s.maxPressureIterations = r.atLeast(sol, at, "Max Pressure Iterations", 1);
+  // Auto: the saddle-point step without friction; with friction the Anderson
+  // loop, whose extra passes converge the path-dependent friction multipliers
+  // further than their tolerance (docs/performance.md, "Defaults and why").
+  enum class Update { Auto, SaddlePoint, Anderson };
+  const Update update = r.choice(sol, at, "Pressure Update",
+                                 std::vector<std::pair<const char*, Update>>{{"Auto", Update::Auto},
+                                                                             {"Saddle Point", Update::SaddlePoint},
+                                                                             {"Anderson", Update::Anderson}});
+  s.pressureUpdate = update == Update::SaddlePoint || (update == Update::Auto && !friction) ? PressureUpdate::SaddlePoint
+                                                                                            : PressureUpdate::Anderson;
+  s.pressureStepSchur = r.choice(sol, at, "Pressure Step Schur",
+                                 std::vector<std::pair<const char*, Schur>>{
+                                     {"Auto", Schur::Auto}, {"Laplacian", Schur::Laplacian}, {"Diagonal", Schur::Diagonal}});
+  s.pressureAccelerationDepth = r.atLeast(sol, at, "Pressure Acceleration Depth", 0);
+  // Automatic: the fastest on G1 for each update (docs/performance.md,
+  // "Defaults and why"): 3e-2 with the saddle-point step, 1e-2 with Anderson.
+  s.minimumSolvePenalty = sol.get<double>("Minimum Solve Penalty");
+  if (!(s.minimumSolvePenalty > 0 || s.minimumSolvePenalty == -1) || !std::isfinite(s.minimumSolvePenalty))
+    r.fail("Solver/Minimum Solve Penalty", "must be > 0, or -1 (automatic), got " + Teuchos::toString(s.minimumSolvePenalty));
+  if (s.minimumSolvePenalty == -1) s.minimumSolvePenalty = s.pressureUpdate == PressureUpdate::SaddlePoint ? 3e-2 : 1e-2;
+  s.nox = sol.sublist("NOX");
+  s.stratimikos = sol.sublist("Stratimikos");
+  return s;
+}
+
+SolverSettings SolverSettings::defaults(bool friction) {
+  ParameterList list;
+  declare(list);
+  return parse(list, ParameterReader{"(defaults)"}, friction);
+}
+
+}  // namespace capstan

@@ -1,0 +1,57 @@
+// The Solver sublist, typed: Newton, the linear solvers and the pressure loop.
+// declare() states every parameter with its default and doc string (`capstan
+// params`); parse() reads a validated list into the struct and resolves the
+// automatic choices, so the run sees what is used.
+#pragma once
+
+#include <Teuchos_ParameterList.hpp>
+
+#include <utility>
+#include <vector>
+
+#include "parameters.hpp"
+
+namespace capstan {
+
+struct SolverSettings {
+  enum class LinearSolver { Auto, GMRES, CG, Direct };
+  enum class Preconditioner { Auto, ILU, Jacobi, MueLu, None };
+  enum class Reuse { Adaptive, None };
+  enum class ToleranceMethod { Adaptive, Fixed };
+  enum class Predictor { Tangent, Previous };
+  enum class LineSearch { Backtrack, Polynomial, FullStep };
+  enum class PressureUpdate { SaddlePoint, Anderson };  // Auto is resolved by parse()
+  enum class Schur { Auto, Laplacian, Diagonal };
+
+  LinearSolver linearSolver{};
+  int directSolverMaxDofs = 0;
+  Preconditioner preconditioner{};
+  int iluLevel = 0;
+  Reuse preconditionerReuse{};
+  double linearTolerance = 0;
+  ToleranceMethod linearToleranceMethod{};
+  int maxLinearIterations = 0;
+  double newtonRelativeTolerance = 0;
+  double newtonAbsoluteTolerance = 0;  // 0: 1e-13 c L^2 (Model)
+  int maxNewtonIterations = 0;
+  Predictor predictor{};
+  LineSearch lineSearch{};
+  double volumeTolerance = 0;
+  int maxPressureIterations = 0;
+  PressureUpdate pressureUpdate{};
+  Schur pressureStepSchur{};
+  int pressureAccelerationDepth = 0;
+  double minimumSolvePenalty = 0;  // resolved: > 0
+  Teuchos::ParameterList nox, stratimikos;  // passed to NOX and Stratimikos over capstan's defaults
+
+  static void declare(Teuchos::ParameterList& solver);
+  // `friction`: some capstan has friction (Pressure Update = Auto picks Anderson).
+  static SolverSettings parse(const Teuchos::ParameterList& solver, const ParameterReader& r, bool friction);
+  // The defaults (tests, benchmarks).
+  static SolverSettings defaults(bool friction = false);
+
+  static const std::vector<std::pair<const char*, LinearSolver>> linearSolvers;
+  static const std::vector<std::pair<const char*, LineSearch>> lineSearches;
+};
+
+}  // namespace capstan
