@@ -4,7 +4,7 @@ set -euo pipefail
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
 packages=(trilinos-all-dev libmumps-dev libptscotch-dev libscotch-dev libmetis-dev libhdf5-openmpi-dev
-          openmpi-bin libgtest-dev cmake g++ make python3 python3-numpy python3-matplotlib python3-h5py)
+          openmpi-bin libopenblas0-serial libgtest-dev cmake g++ make python3 python3-numpy python3-matplotlib python3-h5py)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

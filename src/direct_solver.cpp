@@ -105,6 +105,7 @@ void MumpsSolver::initialize(const Teuchos::Comm<int>& comm) {
   ICNTL(id, 18) = 3;  // distributed assembled matrix, pattern at analysis, values at factorisation
   ICNTL(id, 20) = 0;  // dense right-hand sides on the host
   ICNTL(id, 21) = 0;  // centralised solution (overwrites the right-hand sides)
+  ICNTL(id, 8) = options_.scaling ? 77 : 0;
   ICNTL(id, 28) = 1;  // sequential analysis: Debian's build has neither ParMETIS nor PT-SCOTCH
   if (options_.workspaceIncreasePercent >= 0) ICNTL(id, 14) = options_.workspaceIncreasePercent;
 }

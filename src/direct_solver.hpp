@@ -47,6 +47,13 @@ struct MumpsOptions {
   int workspaceIncreasePercent = -1;
   // MUMPS' own printing (ICNTL(1..4)); silent by default.
   bool verbose = false;
+  // Row and column scaling before each factorisation (ICNTL(8) = 77, MUMPS'
+  // automatic choice) or none (ICNTL(8) = 0). Off: the 3D drive's 422
+  // factorisations (pinch-roller.xml, 2 steps) took 23.6 ms each against
+  // 32.9 ms with scaling, with the same Newton iterations and answers (the
+  // core's rotation 5.5e-12 apart); threshold pivoting still guards the
+  // pivots (tests/integration/direct_solvers.py checks the answers).
+  bool scaling = false;
 };
 
 class MumpsSolver {

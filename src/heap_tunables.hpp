@@ -12,8 +12,10 @@
 //   basis anew and each MueLu set-up its matrices, so the kernel zeroed fresh
 //   pages over and over, at about 1 GB/s here.
 //
-// How: glibc reads GLIBC_TUNABLES only when a program starts, so the program
-// runs itself again, once, with the settings added. A setting the user's
+// How: glibc reads GLIBC_TUNABLES only when a program starts. `capstan` is a
+// small launcher (drivers/launcher.cpp) that adds them and starts the solver
+// program, capstan-solver; a program started without them (capstan-solver
+// itself, capstan_bench) runs itself again, once, with the settings added. A setting the user's
 // GLIBC_TUNABLES already names keeps the user's value (glibc.malloc.hugetlb=0
 // turns huge pages off). A glibc that lacks a tunable ignores it. Must run
 // before MPI starts.
@@ -39,7 +41,9 @@ inline constexpr HeapTunable kHeapTunables[] = {
     {"glibc.malloc.trim_threshold", "68719476736"},
 };
 
-inline void reexecWithHeapTunables(char** argv) {
+// Adds capstan's tunables to GLIBC_TUNABLES (the user's own settings win);
+// returns whether anything was added.
+inline bool addHeapTunables() {
   const char* user = std::getenv("GLIBC_TUNABLES");
   std::string value = user ? user : "";
   bool added = false;
@@ -48,8 +52,21 @@ inline void reexecWithHeapTunables(char** argv) {
     value += (value.empty() ? "" : ":") + std::string(t.name) + "=" + t.value;
     added = true;
   }
-  if (!added || setenv("GLIBC_TUNABLES", value.c_str(), 1) != 0) return;
-  execv("/proc/self/exe", argv);  // returns only if it failed: run on with glibc's defaults
+  return added && setenv("GLIBC_TUNABLES", value.c_str(), 1) == 0;
+}
+
+// A run started without mpiexec is an MPI singleton: by default Open MPI then
+// starts a daemon (orted) for it, 0.12 s of every such run's start-up
+// (docs/performance.md, "Start-up"). An isolated singleton needs none and
+// can do all capstan does. Read by MPI_Init, so it may be set in-process.
+inline void isolateMpiSingleton() {
+  const bool launched = std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMIX_RANK");
+  if (!launched) setenv("OMPI_MCA_ess_singleton_isolated", "1", 0);
+}
+
+inline void reexecWithHeapTunables(char** argv) {
+  isolateMpiSingleton();
+  if (addHeapTunables()) execv("/proc/self/exe", argv);  // returns only if it failed: run on with glibc's defaults
 }
 
 // Whether this process asked for huge pages (for the programs' reports).

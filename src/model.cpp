@@ -1,5 +1,7 @@
 #include "model.hpp"
 
+#include <algorithm>
+
 #include <Teuchos_CommHelpers.hpp>
 
 #include <cmath>
@@ -27,7 +29,11 @@ Model::Model(const Scene& scene_, const RCP<const Comm>& comm_)
   mesh = distributeMesh(*generator, comm, partitionFor(m.partition, m.cells[2], comm->getSize()));
   assembly = std::make_unique<Assembly>(mesh, scene);
   try {
-    newton = std::make_unique<NewtonSolver>(*assembly, scene.solver);
+    const bool friction = std::any_of(scene.capstans.begin(), scene.capstans.end(),
+                                      [](const CapstanSpec& c) { return c.friction.on(); });
+    newton = std::make_unique<NewtonSolver>(
+        *assembly, scene.solver.resolved(long(assembly->dofMap()->getGlobalNumElements()),
+                                         m.type == MeshSpec::Type::Annulus, friction));
   } catch (const InputError& e) {  // the Solver/NOX or Solver/Stratimikos sublist
     throw InputError(scene.file + ": " + e.what());
   }

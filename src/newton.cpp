@@ -8,6 +8,7 @@
 #include <NOX_Thyra_Group.H>
 #include <Stratimikos_DefaultLinearSolverBuilder.hpp>
 #include <Stratimikos_MueLuHelpers.hpp>
+#include "mumps_solve_factory.hpp"
 #include <Teuchos_AbstractFactoryStd.hpp>
 #include <Teuchos_oblackholestream.hpp>
 #include <Thyra_DefaultLinearOpSource.hpp>
@@ -259,22 +260,18 @@ RCP<Tpetra::MultiVector<>> rigidBodyModes(const Assembly& assembly) {
 
 // capstan's solver knobs as Stratimikos parameters; the scene's Solver/Stratimikos
 // sublist is applied over them.
-Teuchos::ParameterList stratimikosParameters(const SolverSettings& solver, long dofs, int ranks,
+// capstan's solver knobs (Auto resolved) as Stratimikos parameters.
+Teuchos::ParameterList stratimikosParameters(const SolverSettings& solver, int ranks,
                                              const RCP<Tpetra::MultiVector<>>& nullspace,
                                              const RCP<Tpetra::MultiVector<>>& coordinates) {
   Teuchos::ParameterList p("Stratimikos");
   using S = SolverSettings;
-  S::LinearSolver method = solver.linearSolver;
-  // Auto: a sparse direct solve is fastest and immune to the penalty's
-  // conditioning on small meshes; Krylov with ILU above that size.
-  if (method == S::LinearSolver::Auto)
-    method = dofs <= solver.directSolverMaxDofs ? S::LinearSolver::Direct : S::LinearSolver::GMRES;
-  // Amesos2's KLU2 on several ranks solves our matrices wrongly in Trilinos
-  // 13.2 (Newton stalls: G1 and H1 ended with exit 2; first seen with a rigid
-  // core's rows, docs/pinch-roller.md): GMRES there, whatever the scene asked.
-  if (method == S::LinearSolver::Direct && ranks > 1) method = S::LinearSolver::GMRES;
+  const S::LinearSolver method = solver.linearSolver;
+  // Direct: MUMPS on any number of ranks (src/mumps_solve_factory.hpp).
+  // Amesos2's KLU2, still selectable through Solver/Stratimikos, solves our
+  // matrices wrongly on several ranks in Trilinos 13.2.
   if (method == S::LinearSolver::Direct) {
-    p.set("Linear Solver Type", "Amesos2");
+    p.set("Linear Solver Type", "MUMPS");
     p.set("Preconditioner Type", "None");
   } else {
     p.set("Linear Solver Type", "Belos");
@@ -288,12 +285,11 @@ Teuchos::ParameterList stratimikosParameters(const SolverSettings& solver, long 
       st.set("Num Blocks", 200);
       st.set("Maximum Restarts", 20);
     }
-    S::Preconditioner prec = solver.preconditioner;
-    // Auto: smoothed aggregation pays for its setup from about 1000 dofs on;
-    // below, ILU is cheaper (docs/performance.md, "Defaults and why").
-    if (prec == S::Preconditioner::Auto) prec = dofs >= 1000 ? S::Preconditioner::MueLu : S::Preconditioner::ILU;
+    const S::Preconditioner prec = solver.preconditioner;
     if (prec == S::Preconditioner::None) {
       p.set("Preconditioner Type", "None");
+    } else if (prec == S::Preconditioner::LU) {
+      p.set("Preconditioner Type", "MUMPS");  // src/mumps_solve_factory.hpp
     } else if (prec == S::Preconditioner::MueLu) {
       // Smoothed aggregation with the rigid-body modes, Chebyshev smoothing.
       p.set("Preconditioner Type", "MueLu");
@@ -396,7 +392,11 @@ struct NewtonSolver::Impl {
     // anyway. Solving to eta_k ~ (|R_k|/|R_k-1|)^1.5 keeps Newton superlinear
     // and cuts the Krylov iterations 2.5x (docs/performance.md, "Defaults and
     // why"). The answer is the same: Newton still converges to its own tolerance.
-    if (solver.linearToleranceMethod == SolverSettings::ToleranceMethod::Adaptive) {
+    // Not with an LU preconditioner: GMRES converges in a few iterations
+    // whatever the tolerance, and loose solves only cost Newton iterations
+    // (the 3D drive's first step: 77 against 51).
+    if (solver.linearToleranceMethod == SolverSettings::ToleranceMethod::Adaptive &&
+        solver.preconditioner != SolverSettings::Preconditioner::LU) {
       newton.set("Forcing Term Method", "Type 2");
       newton.set("Forcing Term Minimum Tolerance", solver.linearTolerance);
       // Never looser than 1e-3: with NOX's default ceiling a soft foundation
@@ -414,20 +414,22 @@ struct NewtonSolver::Impl {
   }
 };
 
-NewtonSolver::NewtonSolver(Assembly& assembly, const SolverSettings& solver)
-    : impl_(std::make_unique<Impl>(assembly, solver)) {
+NewtonSolver::NewtonSolver(Assembly& assembly, const SolverSettings& settings)
+    : impl_(std::make_unique<Impl>(assembly, settings.resolved(long(assembly.dofMap()->getGlobalNumElements()),
+                                                                false, false))) {
+  const SolverSettings& solver = impl_->solver;
   Stratimikos::DefaultLinearSolverBuilder builder;
   using PrecBase = Thyra::PreconditionerFactoryBase<double>;
   using Ifpack2Factory = Thyra::Ifpack2PreconditionerFactory<Tpetra::CrsMatrix<>>;
   builder.setPreconditioningStrategyFactory(Teuchos::abstractFactoryStd<PrecBase, Ifpack2Factory>(),
                                             "Ifpack2");
   Stratimikos::enableMueLu(builder);
+  builder.setLinearSolveStrategyFactory(
+      Teuchos::abstractFactoryStd<Thyra::LinearOpWithSolveFactoryBase<double>, MumpsSolveFactory>(), "MUMPS");
+  builder.setPreconditioningStrategyFactory(Teuchos::abstractFactoryStd<PrecBase, MumpsPreconditionerFactory>(),
+                                            "MUMPS");
   const int ranks = assembly.dofMap()->getComm()->getSize();
-  const bool rank0 = assembly.dofMap()->getComm()->getRank() == 0;
-  if (ranks > 1 && solver.linearSolver == SolverSettings::LinearSolver::Direct && rank0)  // (stratimikosParameters)
-    std::fprintf(stderr, "capstan: note: Solver/Linear Solver = Direct is not reliable on %d ranks "
-                         "(Amesos2 KLU2 in Trilinos 13.2); using GMRES\n", ranks);
-  impl_->strat = stratimikosParameters(solver, long(assembly.dofMap()->getGlobalNumElements()), ranks,
+  impl_->strat = stratimikosParameters(solver, ranks,
                                        solver.preconditioner != SolverSettings::Preconditioner::ILU &&
                                                solver.preconditioner != SolverSettings::Preconditioner::Jacobi
                                            ? rigidBodyModes(assembly)
@@ -550,7 +552,9 @@ std::function<void(const Vector&, Vector&)> NewtonSolver::approximateInverse() {
   };
 }
 
-bool NewtonSolver::iterative() const { return !impl_->newtonPrecFactory.is_null(); }
+bool NewtonSolver::iterative() const {
+  return !impl_->newtonPrecFactory.is_null() && impl_->solver.preconditioner != SolverSettings::Preconditioner::LU;
+}
 
 int NewtonSolver::preconditionerBuilds() const {
   return impl_->newtonPrecFactory.is_null() ? 0 : impl_->newtonPrecFactory->builds();

@@ -26,6 +26,8 @@ struct NewtonResult {
 
 class NewtonSolver {
  public:
+  // `solver`: its Auto choices are resolved here (SolverSettings::resolved)
+  // if the caller has not resolved them for the scene's kind.
   NewtonSolver(Assembly& assembly, const SolverSettings& solver);
   ~NewtonSolver();
   // Solves R(u) = 0 from the initial guess u (updated in place) until
@@ -53,7 +55,9 @@ class NewtonSolver {
   double preconditionerSeconds() const;
   // Preconditioners Newton has built so far (the lagged one; CAPSTAN_NEWTON_LOG).
   int preconditionerBuilds() const;
-  // Whether the linear solves are Krylov solves (false: a direct solver).
+  // Whether approximateInverse() is only approximate: a Krylov solver's
+  // multigrid or ILU preconditioner (false: a direct solver, or an LU
+  // preconditioner, whose inverse is that of a matrix near Newton's).
   bool iterative() const;
   // The linear solver and preconditioner parameters in use (Stratimikos list).
   const Teuchos::ParameterList& linearSolverParameters() const;

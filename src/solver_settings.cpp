@@ -12,12 +12,16 @@ const std::vector<std::pair<const char*, S::LineSearch>> S::lineSearches = {
 
 void SolverSettings::declare(ParameterList& sol) {
   sol.set("Linear Solver", std::string("Auto"),
-          "Auto | GMRES | CG | Direct (Belos GMRES, Belos CG, Amesos2 KLU2). Auto: Direct up to "
-          "Direct Solver Max Dofs on one rank, GMRES otherwise");
-  sol.set("Direct Solver Max Dofs", 5000, "Auto: largest problem solved directly");
+          "Auto | GMRES | CG | Direct (Belos GMRES, Belos CG, MUMPS on any number of ranks). Auto, up to "
+          "Direct Solver Max Dofs: Direct with friction, GMRES with an LU preconditioner without; "
+          "above it GMRES (docs/performance.md, \"Linear solvers\")");
+  sol.set("Direct Solver Max Dofs", 0,
+          "Auto: the largest problem factorised by MUMPS; 0: automatic, 5,000 on a Box mesh, 50,000 "
+          "on an Annulus (graded rings, on which smoothed aggregation needs hundreds of iterations)");
   sol.set("Preconditioner", std::string("Auto"),
-          "Auto | ILU | Jacobi | MueLu | None (Ifpack2 RILUK per rank, Jacobi relaxation; MueLu smoothed "
-          "aggregation with the rigid-body modes). Auto: MueLu from 1000 dofs, ILU below");
+          "Auto | ILU | Jacobi | MueLu | LU | None (Ifpack2 RILUK per rank, Jacobi relaxation; MueLu smoothed "
+          "aggregation with the rigid-body modes; LU: a MUMPS factorisation kept across Newton iterations "
+          "while it works, see Preconditioner Reuse). Auto: MueLu from 1000 dofs, ILU below");
   sol.set("ILU Level", 1, "ILU: level of fill (>= 0)");
   sol.set("Preconditioner Reuse", std::string("Adaptive"),
           "Adaptive | None. Adaptive: Newton builds its preconditioner at each load step's start "
@@ -65,12 +69,12 @@ SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterRe
   const std::string at = "Solver";
   SolverSettings s;
   s.linearSolver = r.choice(sol, at, "Linear Solver", linearSolvers);
-  s.directSolverMaxDofs = sol.get<int>("Direct Solver Max Dofs");
+  s.directSolverMaxDofs = r.atLeast(sol, at, "Direct Solver Max Dofs", 0);
   s.preconditioner = r.choice(sol, at, "Preconditioner",
                               std::vector<std::pair<const char*, Preconditioner>>{
                                   {"Auto", Preconditioner::Auto}, {"ILU", Preconditioner::ILU},
                                   {"Jacobi", Preconditioner::Jacobi}, {"MueLu", Preconditioner::MueLu},
-                                  {"None", Preconditioner::None}});
+                                  {"LU", Preconditioner::LU}, {"None", Preconditioner::None}});
   s.iluLevel = r.atLeast(sol, at, "ILU Level", 0);
   s.preconditionerReuse = r.choice(sol, at, "Preconditioner Reuse",
                                    std::vector<std::pair<const char*, Reuse>>{{"Adaptive", Reuse::Adaptive},
@@ -112,6 +116,30 @@ SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterRe
   if (s.minimumSolvePenalty == -1) s.minimumSolvePenalty = s.pressureUpdate == PressureUpdate::SaddlePoint ? 3e-2 : 1e-2;
   s.nox = sol.sublist("NOX");
   s.stratimikos = sol.sublist("Stratimikos");
+  return s;
+}
+
+SolverSettings SolverSettings::resolved(long dofs, bool annulus, bool friction) const {
+  SolverSettings s = *this;
+  if (s.linearSolver == LinearSolver::Auto) {
+    const long most = s.directSolverMaxDofs > 0 ? s.directSolverMaxDofs : annulus ? 50000 : 5000;
+    if (dofs > most) {
+      s.linearSolver = LinearSolver::GMRES;
+    } else if (friction) {
+      // Friction changes Newton's matrix much from one iteration to the next:
+      // a new factorisation each time beats reusing one (the 3D drive: 40 ms a
+      // Newton iteration against 44 ms with GMRES + LU, 334 ms with MueLu).
+      s.linearSolver = LinearSolver::Direct;
+    } else {
+      // Without it, one factorisation serves several Newton iterations (G1:
+      // 0.54 s against 0.81 s factorising each time; the Hertz ring: 1.69 s
+      // against 2.45 s).
+      s.linearSolver = LinearSolver::GMRES;
+      if (s.preconditioner == Preconditioner::Auto) s.preconditioner = Preconditioner::LU;
+    }
+  }
+  if (s.preconditioner == Preconditioner::Auto)
+    s.preconditioner = dofs >= 1000 ? Preconditioner::MueLu : Preconditioner::ILU;
   return s;
 }
 

@@ -15,7 +15,7 @@ namespace capstan {
 
 struct SolverSettings {
   enum class LinearSolver { Auto, GMRES, CG, Direct };
-  enum class Preconditioner { Auto, ILU, Jacobi, MueLu, None };
+  enum class Preconditioner { Auto, ILU, Jacobi, MueLu, LU, None };
   enum class Reuse { Adaptive, None };
   enum class ToleranceMethod { Adaptive, Fixed };
   enum class Predictor { Tangent, Previous };
@@ -24,7 +24,7 @@ struct SolverSettings {
   enum class Schur { Auto, Laplacian, Diagonal };
 
   LinearSolver linearSolver{};
-  int directSolverMaxDofs = 0;
+  int directSolverMaxDofs = 0;  // 0: automatic (resolved())
   Preconditioner preconditioner{};
   int iluLevel = 0;
   Reuse preconditionerReuse{};
@@ -47,6 +47,10 @@ struct SolverSettings {
   static void declare(Teuchos::ParameterList& solver);
   // `friction`: some capstan has friction (Pressure Update = Auto picks Anderson).
   static SolverSettings parse(const Teuchos::ParameterList& solver, const ParameterReader& r, bool friction);
+  // Linear Solver = Auto and Preconditioner = Auto resolved for a problem of
+  // `dofs` unknowns on an annulus (or box) mesh, with or without friction
+  // (docs/performance.md, "Linear solvers", has the measurements).
+  SolverSettings resolved(long dofs, bool annulus, bool friction) const;
   // The defaults (tests, benchmarks).
   static SolverSettings defaults(bool friction = false);
 

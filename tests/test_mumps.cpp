@@ -16,7 +16,12 @@
 #include <string>
 #include <vector>
 
+#include <Thyra_LinearOpWithSolveBase.hpp>
+#include <Thyra_LinearOpWithSolveFactoryHelpers.hpp>
+#include <Thyra_TpetraThyraWrappers.hpp>
+
 #include "direct_solver.hpp"
+#include "mumps_solve_factory.hpp"
 
 using namespace capstan;
 using CrsMatrix = Tpetra::CrsMatrix<>;
@@ -122,6 +127,57 @@ TEST(Mumps, SolvesConvectionDiffusionWithThreeRightHandSides) {
   EXPECT_GE(solver.analysisSeconds(), 0.0);
   EXPECT_GE(solver.factorSeconds(), 0.0);
   EXPECT_GE(solver.solveSeconds(), 0.0);
+}
+
+// The layer Newton, the predictor and the pressure step solve through: Thyra
+// operators from MumpsSolveFactory. Two operators of one pattern share one
+// analysis, each solve uses its own operator's values (refactored when the
+// other was factored since), and several right-hand sides solve at once.
+TEST(MumpsThyra, OperatorsShareTheAnalysisAndSolveWithTheirOwnValues) {
+  using Converter = Thyra::TpetraOperatorVectorExtraction<double>;
+  auto map = contiguousMap(N, worldComm());
+  auto A = convectionDiffusion(map, ConvDiff{});
+  auto B = convectionDiffusion(map, ConvDiff{0.5, 1.0, false});  // same pattern, other values
+  auto factory = rcp(new MumpsSolveFactory);
+  factory->setParameterList(Teuchos::parameterList());
+  auto thyra = [&](const RCP<CrsMatrix>& M) {
+    return Thyra::createConstLinearOp(Teuchos::rcp_implicit_cast<const Tpetra::Operator<>>(M));
+  };
+  auto solveWith = [&](const Thyra::LinearOpWithSolveBase<double>& lows, const CrsMatrix& M) {
+    auto xTrue = knownSolution(map, 3);
+    auto b = rcp(new MultiVector(map, 3)), x = rcp(new MultiVector(map, 3));
+    M.apply(*xTrue, *b);
+    auto space = Thyra::createVectorSpace<double>(map);
+    auto bt = Thyra::createConstMultiVector(RCP<const MultiVector>(b), space);
+    auto xt = Thyra::createMultiVector(x, space);
+    const auto status = Thyra::solve<double>(lows, Thyra::NOTRANS, *bt, xt.ptr());
+    EXPECT_EQ(status.solveStatus, Thyra::SOLVE_STATUS_CONVERGED);
+    MultiVector e(*xTrue, Teuchos::Copy);
+    e.update(1.0, *Converter::getTpetraMultiVector(xt), -1.0);
+    std::vector<double> en(3);
+    e.normInf(en);
+    for (int c = 0; c < 3; ++c) EXPECT_LT(en[c], 1e-10) << "column " << c;
+  };
+  auto lowsA = Thyra::linearOpWithSolve<double>(*factory, thyra(A));
+  auto lowsB = Thyra::linearOpWithSolve<double>(*factory, thyra(B));
+  const MumpsSolver& solver = *factory->shared()->solver;
+  EXPECT_EQ(solver.numAnalyses(), 1) << "one pattern, one analysis";
+  EXPECT_EQ(solver.numFactorizations(), 2);
+  solveWith(*lowsB, *B);
+  EXPECT_EQ(solver.numFactorizations(), 2) << "B is factored: solved as it is";
+  solveWith(*lowsA, *A);
+  EXPECT_EQ(solver.numFactorizations(), 3) << "A refactored after B";
+  solveWith(*lowsA, *A);
+  EXPECT_EQ(solver.numFactorizations(), 3);
+  // A changed pattern: the next operator gets a new analysis.
+  auto C = convectionDiffusion(map, ConvDiff{1.0, 0.0, true});
+  auto lowsC = Thyra::linearOpWithSolve<double>(*factory, thyra(C));
+  EXPECT_EQ(solver.numAnalyses(), 2);
+  solveWith(*lowsC, *C);
+  // An unknown ordering is an error naming it.
+  auto bad = Teuchos::parameterList();
+  bad->set("Ordering", "Nested");
+  EXPECT_THROW(factory->setParameterList(bad), std::invalid_argument);
 }
 
 TEST(Mumps, EveryOrderingSolves) {

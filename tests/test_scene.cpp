@@ -663,3 +663,35 @@ TEST_F(SceneTest, UnreachableCapstanWarning) {
 #endif
 
 }  // namespace
+
+// Linear Solver = Auto by the scene's kind and size (docs/performance.md,
+// "Linear solvers"): MUMPS up to 5,000 dofs on a box, 50,000 on an annulus;
+// factorised every Newton iteration with friction, kept as GMRES's LU
+// preconditioner without; GMRES with MueLu (ILU below 1000 dofs) above.
+TEST(SolverSettings, AutoResolvesByKindAndSize) {
+  using S = SolverSettings;
+  const S s = S::defaults();
+  EXPECT_EQ(s.directSolverMaxDofs, 0);
+  auto pick = [&](const S& from, long dofs, bool annulus, bool friction) {
+    const S r = from.resolved(dofs, annulus, friction);
+    return std::make_pair(r.linearSolver, r.preconditioner);
+  };
+  EXPECT_EQ(pick(s, 1575, false, false), std::make_pair(S::LinearSolver::GMRES, S::Preconditioner::LU));
+  EXPECT_EQ(pick(s, 1920, true, true).first, S::LinearSolver::Direct);
+  EXPECT_EQ(pick(s, 5000, false, true).first, S::LinearSolver::Direct);
+  EXPECT_EQ(pick(s, 5001, false, true), std::make_pair(S::LinearSolver::GMRES, S::Preconditioner::MueLu));
+  EXPECT_EQ(pick(s, 15120, true, false), std::make_pair(S::LinearSolver::GMRES, S::Preconditioner::LU));
+  EXPECT_EQ(pick(s, 50001, true, false), std::make_pair(S::LinearSolver::GMRES, S::Preconditioner::MueLu));
+  EXPECT_EQ(pick(s, 500, true, false).second, S::Preconditioner::LU);
+  // A scene's own choices stay; a positive Direct Solver Max Dofs applies to both meshes.
+  S own = s;
+  own.preconditioner = S::Preconditioner::ILU;
+  EXPECT_EQ(pick(own, 1575, false, false), std::make_pair(S::LinearSolver::GMRES, S::Preconditioner::ILU));
+  own = s;
+  own.linearSolver = S::LinearSolver::Direct;
+  EXPECT_EQ(pick(own, 1000000, false, false).first, S::LinearSolver::Direct);
+  own = s;
+  own.directSolverMaxDofs = 100;
+  EXPECT_EQ(pick(own, 1575, true, true), std::make_pair(S::LinearSolver::GMRES, S::Preconditioner::MueLu));
+  EXPECT_EQ(pick(own, 500, true, true), std::make_pair(S::LinearSolver::GMRES, S::Preconditioner::ILU));
+}

@@ -68,14 +68,9 @@ for st in free["steps"]:
     T.check(abs(core["torque"]) < 1e-8 * F * R_roller, f"free step {st['step']}: core torque {core['torque']:.3g} = 0")
     T.check(abs(cap["force"][0]) < 0.05 * mu * F,
             f"free step {st['step']}: net tangential nip force {cap['force'][0]:.3g} << mu N = {mu * F}")
-# GMRES + ILU on 2 ranks: the distributed KLU2 solve gave wrong Newton directions
-# with the core's rows (docs/pinch-roller.md). Every Krylov solve to 1e-12
-# (Fixed): with the default Eisenstat-Walker tolerances each step ends just
-# below the Newton tolerance, and the free rotation, held only by friction,
-# then differs by ~1e-5 between rank counts (docs/performance.md).
-two = run(slice_scene, "free-2ranks", ranks=2,
-          sets=["Solver/Linear Solver=GMRES", "Solver/Preconditioner=ILU", "Solver/Linear Tolerance=1e-12",
-                "Solver/Linear Tolerance Method=Fixed"])
+# 2 ranks with the solver 1 rank uses (Auto: the direct solver, MUMPS, on the
+# distributed matrix with the core's rows).
+two = run(slice_scene, "free-2ranks", ranks=2)
 # Where both runs cut a step into the same sub-steps they agree to solver
 # tolerance (1e-8). A cut is a discrete decision (Newton failed within its
 # limit), and round-off can tip it one way on one rank count and the other

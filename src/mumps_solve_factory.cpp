@@ -1,0 +1,248 @@
+#include "mumps_solve_factory.hpp"
+
+#include <Teuchos_StandardParameterEntryValidators.hpp>
+#include <Thyra_DefaultLinearOpSource.hpp>
+#include <Thyra_DefaultPreconditioner.hpp>
+#include <Thyra_LinearOpWithSolveBase.hpp>
+#include <Thyra_TpetraThyraWrappers.hpp>
+
+#include <stdexcept>
+
+namespace capstan {
+
+using Teuchos::RCP;
+using Teuchos::rcp;
+
+namespace {
+
+using ConverterT = Thyra::TpetraOperatorVectorExtraction<double>;
+using Shared = MumpsSolveFactory::Shared;
+
+// An operator with its factorisation in the shared solver.
+class MumpsLinearOpWithSolve : public Thyra::LinearOpWithSolveBase<double> {
+ public:
+  explicit MumpsLinearOpWithSolve(std::shared_ptr<Shared> shared) : shared_(std::move(shared)) {}
+  ~MumpsLinearOpWithSolve() override {
+    if (shared_->factoredFor == this) shared_->factoredFor = nullptr;
+  }
+
+  void initialize(const RCP<const Thyra::LinearOpSourceBase<double>>& src) {
+    src_ = src;
+    op_ = src->getOp();
+    matrix_ = Teuchos::rcp_dynamic_cast<const MumpsSolver::CrsMatrix>(ConverterT::getConstTpetraOperator(op_));
+    if (matrix_.is_null()) throw std::invalid_argument("MUMPS: the operator is not a Tpetra::CrsMatrix");
+    factor();
+  }
+  RCP<const Thyra::LinearOpSourceBase<double>> release() {
+    auto src = src_;
+    if (shared_->factoredFor == this) shared_->factoredFor = nullptr;
+    src_ = Teuchos::null, op_ = Teuchos::null, matrix_ = Teuchos::null;
+    return src;
+  }
+
+  RCP<const Thyra::VectorSpaceBase<double>> range() const override { return op_->range(); }
+  RCP<const Thyra::VectorSpaceBase<double>> domain() const override { return op_->domain(); }
+
+ protected:
+  bool opSupportedImpl(Thyra::EOpTransp t) const override { return Thyra::opSupported(*op_, t); }
+  void applyImpl(Thyra::EOpTransp t, const Thyra::MultiVectorBase<double>& X,
+                 const Teuchos::Ptr<Thyra::MultiVectorBase<double>>& Y, double alpha, double beta) const override {
+    Thyra::apply(*op_, t, X, Y, alpha, beta);
+  }
+  bool solveSupportsImpl(Thyra::EOpTransp t) const override { return Thyra::real_trans(t) == Thyra::NOTRANS; }
+  bool solveSupportsSolveMeasureTypeImpl(Thyra::EOpTransp, const Thyra::SolveMeasureType&) const override {
+    return true;  // exact to round-off
+  }
+  Thyra::SolveStatus<double> solveImpl(Thyra::EOpTransp, const Thyra::MultiVectorBase<double>& B,
+                                       const Teuchos::Ptr<Thyra::MultiVectorBase<double>>& X,
+                                       const Teuchos::Ptr<const Thyra::SolveCriteria<double>>) const override {
+    // Another operator was factored since this one: its values again.
+    if (shared_->factoredFor != this) const_cast<MumpsLinearOpWithSolve*>(this)->factor();
+    auto b = ConverterT::getConstTpetraMultiVector(Teuchos::rcpFromRef(B));
+    auto x = ConverterT::getTpetraMultiVector(Teuchos::rcpFromPtr(X));
+    shared_->solver->solve(*b, *x);
+    Thyra::SolveStatus<double> status;
+    status.solveStatus = Thyra::SOLVE_STATUS_CONVERGED;
+    return status;
+  }
+
+ private:
+  void factor() {
+    if (!shared_->solver) shared_->solver = std::make_unique<MumpsSolver>(shared_->options);
+    shared_->factoredFor = nullptr;  // until the factorisation succeeds
+    shared_->solver->factor(*matrix_);
+    shared_->factoredFor = this;
+  }
+
+  std::shared_ptr<Shared> shared_;
+  RCP<const Thyra::LinearOpSourceBase<double>> src_;
+  RCP<const Thyra::LinearOpBase<double>> op_;
+  RCP<const MumpsSolver::CrsMatrix> matrix_;
+};
+
+// The inverse of the matrix a preconditioner was initialised with, applied by
+// MUMPS' triangular solves; refactored if another operator was factored since.
+class MumpsInverseOp : public Thyra::LinearOpBase<double> {
+ public:
+  MumpsInverseOp(std::shared_ptr<Shared> shared, RCP<const Thyra::LinearOpBase<double>> op)
+      : shared_(std::move(shared)), op_(std::move(op)) {
+    matrix_ = Teuchos::rcp_dynamic_cast<const MumpsSolver::CrsMatrix>(ConverterT::getConstTpetraOperator(op_));
+    if (matrix_.is_null()) throw std::invalid_argument("MUMPS: the operator is not a Tpetra::CrsMatrix");
+    factor();
+  }
+  ~MumpsInverseOp() override {
+    if (shared_->factoredFor == this) shared_->factoredFor = nullptr;
+  }
+  RCP<const Thyra::VectorSpaceBase<double>> range() const override { return op_->domain(); }
+  RCP<const Thyra::VectorSpaceBase<double>> domain() const override { return op_->range(); }
+  const RCP<const Thyra::LinearOpBase<double>>& forward() const { return op_; }
+
+ protected:
+  bool opSupportedImpl(Thyra::EOpTransp t) const override { return Thyra::real_trans(t) == Thyra::NOTRANS; }
+  void applyImpl(Thyra::EOpTransp, const Thyra::MultiVectorBase<double>& X,
+                 const Teuchos::Ptr<Thyra::MultiVectorBase<double>>& Y, double alpha, double beta) const override {
+    if (shared_->factoredFor != this) const_cast<MumpsInverseOp*>(this)->factor();
+    auto x = ConverterT::getConstTpetraMultiVector(Teuchos::rcpFromRef(X));
+    auto y = ConverterT::getTpetraMultiVector(Teuchos::rcpFromPtr(Y));
+    MumpsSolver::MultiVector z(y->getMap(), y->getNumVectors());
+    shared_->solver->solve(*x, z);
+    y->update(alpha, z, beta);  // Y = alpha A^-1 X + beta Y
+  }
+
+ private:
+  void factor() {
+    if (!shared_->solver) shared_->solver = std::make_unique<MumpsSolver>(shared_->options);
+    shared_->factoredFor = nullptr;
+    shared_->solver->factor(*matrix_);
+    shared_->factoredFor = this;
+  }
+  std::shared_ptr<Shared> shared_;
+  RCP<const Thyra::LinearOpBase<double>> op_;
+  RCP<const MumpsSolver::CrsMatrix> matrix_;
+};
+
+const std::vector<std::pair<const char*, MumpsOptions::Ordering>> kOrderings = {
+    {"Metis", MumpsOptions::Ordering::Metis}, {"Pord", MumpsOptions::Ordering::Pord},
+    {"AMD", MumpsOptions::Ordering::Amd},     {"AMF", MumpsOptions::Ordering::Amf},
+    {"QAMD", MumpsOptions::Ordering::Qamd}};
+
+RCP<const Teuchos::ParameterList> validOptions() {
+  static RCP<Teuchos::ParameterList> valid;
+  if (valid.is_null()) {
+    valid = Teuchos::parameterList("MUMPS");
+    valid->set("Ordering", std::string("Metis"),
+               "Fill-reducing ordering: Metis (METIS_NodeND, computed by capstan) | Pord | AMD | AMF | QAMD "
+               "(src/direct_solver.hpp has the measurements)");
+    valid->set("Verbose", false, "MUMPS' own printing");
+    valid->set("Scaling", false, "Row and column scaling before each factorisation (MUMPS' automatic choice)");
+  }
+  return valid;
+}
+
+// The factories' parameter list into the shared options (the next
+// factorisation uses them).
+void readOptions(Teuchos::ParameterList& list, Shared& shared) {
+  list.validateParametersAndSetDefaults(*validOptions(), 0);
+  const auto ordering = list.get<std::string>("Ordering");
+  bool known = false;
+  for (const auto& [name, value] : kOrderings)
+    if (ordering == name) shared.options.ordering = value, known = true;
+  if (!known) throw std::invalid_argument("MUMPS: 'Ordering' = '" + ordering + "' is not Metis, Pord, AMD, AMF or QAMD");
+  shared.options.verbose = list.get<bool>("Verbose");
+  shared.options.scaling = list.get<bool>("Scaling");
+  shared.solver.reset();
+  shared.factoredFor = nullptr;
+}
+
+}  // namespace
+
+MumpsSolveFactory::MumpsSolveFactory() : shared_(std::make_shared<Shared>()) {}
+
+bool MumpsSolveFactory::isCompatible(const Thyra::LinearOpSourceBase<double>& src) const {
+  auto op = ConverterT::getConstTpetraOperator(src.getOp());
+  return !Teuchos::rcp_dynamic_cast<const MumpsSolver::CrsMatrix>(op).is_null();
+}
+
+RCP<Thyra::LinearOpWithSolveBase<double>> MumpsSolveFactory::createOp() const {
+  return rcp(new MumpsLinearOpWithSolve(shared_));
+}
+
+void MumpsSolveFactory::initializeOp(const RCP<const Thyra::LinearOpSourceBase<double>>& src,
+                                     Thyra::LinearOpWithSolveBase<double>* op, Thyra::ESupportSolveUse) const {
+  Teuchos::dyn_cast<MumpsLinearOpWithSolve>(*op).initialize(src);
+}
+
+void MumpsSolveFactory::initializePreconditionedOp(const RCP<const Thyra::LinearOpSourceBase<double>>& src,
+                                                   const RCP<const Thyra::PreconditionerBase<double>>&,
+                                                   Thyra::LinearOpWithSolveBase<double>* op,
+                                                   Thyra::ESupportSolveUse use) const {
+  initializeOp(src, op, use);
+}
+
+void MumpsSolveFactory::uninitializeOp(Thyra::LinearOpWithSolveBase<double>* op,
+                                       RCP<const Thyra::LinearOpSourceBase<double>>* src,
+                                       RCP<const Thyra::PreconditionerBase<double>>* prec,
+                                       RCP<const Thyra::LinearOpSourceBase<double>>* approx,
+                                       Thyra::ESupportSolveUse*) const {
+  auto released = Teuchos::dyn_cast<MumpsLinearOpWithSolve>(*op).release();
+  if (src) *src = released;
+  if (prec) *prec = Teuchos::null;
+  if (approx) *approx = Teuchos::null;
+}
+
+RCP<const Teuchos::ParameterList> MumpsSolveFactory::getValidParameters() const { return validOptions(); }
+
+
+void MumpsSolveFactory::setParameterList(const RCP<Teuchos::ParameterList>& list) {
+  readOptions(*list, *shared_);
+  list_ = list;
+}
+
+RCP<Teuchos::ParameterList> MumpsSolveFactory::unsetParameterList() {
+  auto old = list_;
+  list_ = Teuchos::null;
+  return old;
+}
+
+MumpsPreconditionerFactory::MumpsPreconditionerFactory() : shared_(std::make_shared<Shared>()) {}
+
+bool MumpsPreconditionerFactory::isCompatible(const Thyra::LinearOpSourceBase<double>& src) const {
+  auto op = ConverterT::getConstTpetraOperator(src.getOp());
+  return !Teuchos::rcp_dynamic_cast<const MumpsSolver::CrsMatrix>(op).is_null();
+}
+
+RCP<Thyra::PreconditionerBase<double>> MumpsPreconditionerFactory::createPrec() const {
+  return rcp(new Thyra::DefaultPreconditioner<double>);
+}
+
+void MumpsPreconditionerFactory::initializePrec(const RCP<const Thyra::LinearOpSourceBase<double>>& src,
+                                                Thyra::PreconditionerBase<double>* prec,
+                                                Thyra::ESupportSolveUse) const {
+  auto& p = Teuchos::dyn_cast<Thyra::DefaultPreconditioner<double>>(*prec);
+  p.uninitialize();  // the old factorisation's operator goes first
+  p.initializeUnspecified(RCP<const Thyra::LinearOpBase<double>>(rcp(new MumpsInverseOp(shared_, src->getOp()))));
+}
+
+void MumpsPreconditionerFactory::uninitializePrec(Thyra::PreconditionerBase<double>* prec,
+                                                  RCP<const Thyra::LinearOpSourceBase<double>>* src,
+                                                  Thyra::ESupportSolveUse*) const {
+  auto& p = Teuchos::dyn_cast<Thyra::DefaultPreconditioner<double>>(*prec);
+  auto op = Teuchos::rcp_dynamic_cast<const MumpsInverseOp>(p.getUnspecifiedPrecOp());
+  if (src) *src = op.is_null() ? Teuchos::null : Thyra::defaultLinearOpSource<double>(op->forward());
+  p.uninitialize();
+}
+
+void MumpsPreconditionerFactory::setParameterList(const RCP<Teuchos::ParameterList>& list) {
+  readOptions(*list, *shared_);
+  list_ = list;
+}
+
+RCP<Teuchos::ParameterList> MumpsPreconditionerFactory::unsetParameterList() {
+  auto old = list_;
+  list_ = Teuchos::null;
+  return old;
+}
+
+RCP<const Teuchos::ParameterList> MumpsPreconditionerFactory::getValidParameters() const { return validOptions(); }
+
+}  // namespace capstan

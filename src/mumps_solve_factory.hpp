@@ -1,0 +1,88 @@
+// MUMPS behind Thyra's linear-solver interface, so that NOX's Newton, the
+// predictor and the pressure step solve with it exactly as with the Krylov
+// solvers (Stratimikos' "Linear Solver Type" = "MUMPS", registered in
+// src/newton.cpp). One MumpsSolver serves every operator the factory
+// initialises: its analysis is kept while the sparsity pattern holds, and an
+// operator factored for another one is refactored before it solves.
+#pragma once
+
+#include <Thyra_LinearOpWithSolveFactoryBase.hpp>
+#include <Thyra_PreconditionerFactoryBase.hpp>
+
+#include <memory>
+
+#include "direct_solver.hpp"
+
+namespace capstan {
+
+class MumpsSolveFactory : public Thyra::LinearOpWithSolveFactoryBase<double> {
+ public:
+  MumpsSolveFactory();
+
+  bool isCompatible(const Thyra::LinearOpSourceBase<double>& fwdOpSrc) const override;
+  Teuchos::RCP<Thyra::LinearOpWithSolveBase<double>> createOp() const override;
+  void initializeOp(const Teuchos::RCP<const Thyra::LinearOpSourceBase<double>>& fwdOpSrc,
+                    Thyra::LinearOpWithSolveBase<double>* op, Thyra::ESupportSolveUse use) const override;
+  bool supportsPreconditionerInputType(Thyra::EPreconditionerInputType) const override { return false; }
+  // A preconditioner is ignored: the factorisation is exact.
+  void initializePreconditionedOp(const Teuchos::RCP<const Thyra::LinearOpSourceBase<double>>& fwdOpSrc,
+                                  const Teuchos::RCP<const Thyra::PreconditionerBase<double>>& prec,
+                                  Thyra::LinearOpWithSolveBase<double>* op,
+                                  Thyra::ESupportSolveUse use) const override;
+  void uninitializeOp(Thyra::LinearOpWithSolveBase<double>* op,
+                      Teuchos::RCP<const Thyra::LinearOpSourceBase<double>>* fwdOpSrc,
+                      Teuchos::RCP<const Thyra::PreconditionerBase<double>>* prec,
+                      Teuchos::RCP<const Thyra::LinearOpSourceBase<double>>* approxFwdOpSrc,
+                      Thyra::ESupportSolveUse* use) const override;
+
+  // Parameters: "Ordering" (Metis | Pord | AMD | AMF | QAMD), "Verbose".
+  void setParameterList(const Teuchos::RCP<Teuchos::ParameterList>& list) override;
+  Teuchos::RCP<Teuchos::ParameterList> getNonconstParameterList() override { return list_; }
+  Teuchos::RCP<Teuchos::ParameterList> unsetParameterList() override;
+  Teuchos::RCP<const Teuchos::ParameterList> getParameterList() const override { return list_; }
+  Teuchos::RCP<const Teuchos::ParameterList> getValidParameters() const override;
+  std::string description() const override { return "capstan::MumpsSolveFactory"; }
+
+  // The shared solver (counters, timings, memory); created on first use.
+  struct Shared {
+    MumpsOptions options;
+    std::unique_ptr<MumpsSolver> solver;
+    const void* factoredFor = nullptr;  // the operator whose values are factored
+  };
+  const std::shared_ptr<Shared>& shared() const { return shared_; }
+
+ private:
+  std::shared_ptr<Shared> shared_;
+  Teuchos::RCP<Teuchos::ParameterList> list_;
+};
+
+// A MUMPS factorisation as a preconditioner (Stratimikos' "Preconditioner
+// Type" = "MUMPS"): GMRES on Newton's matrix with the LU of an earlier one.
+// Newton's matrices change little from one iteration to the next, so a
+// factorisation kept over several iterations (Solver/Preconditioner Reuse)
+// still makes GMRES converge in a few iterations, each a pair of triangular
+// solves, much cheaper than a new factorisation (docs/performance.md).
+class MumpsPreconditionerFactory : public Thyra::PreconditionerFactoryBase<double> {
+ public:
+  MumpsPreconditionerFactory();
+  bool isCompatible(const Thyra::LinearOpSourceBase<double>& fwdOpSrc) const override;
+  Teuchos::RCP<Thyra::PreconditionerBase<double>> createPrec() const override;
+  void initializePrec(const Teuchos::RCP<const Thyra::LinearOpSourceBase<double>>& fwdOpSrc,
+                      Thyra::PreconditionerBase<double>* prec, Thyra::ESupportSolveUse use) const override;
+  void uninitializePrec(Thyra::PreconditionerBase<double>* prec,
+                        Teuchos::RCP<const Thyra::LinearOpSourceBase<double>>* fwdOpSrc,
+                        Thyra::ESupportSolveUse* use) const override;
+  void setParameterList(const Teuchos::RCP<Teuchos::ParameterList>& list) override;
+  Teuchos::RCP<Teuchos::ParameterList> getNonconstParameterList() override { return list_; }
+  Teuchos::RCP<Teuchos::ParameterList> unsetParameterList() override;
+  Teuchos::RCP<const Teuchos::ParameterList> getParameterList() const override { return list_; }
+  Teuchos::RCP<const Teuchos::ParameterList> getValidParameters() const override;
+  std::string description() const override { return "capstan::MumpsPreconditionerFactory"; }
+  const std::shared_ptr<MumpsSolveFactory::Shared>& shared() const { return shared_; }
+
+ private:
+  std::shared_ptr<MumpsSolveFactory::Shared> shared_;
+  Teuchos::RCP<Teuchos::ParameterList> list_;
+};
+
+}  // namespace capstan
