@@ -49,6 +49,15 @@ struct MumpsSolver::Impl {
   DMUMPS_STRUC_C id{};
   MPI_Comm comm = MPI_COMM_NULL;  // the user's communicator (not owned)
   int rank = 0, size = 1;
+  // Host only (MumpsOptions::hostOnlyBelow): MUMPS runs on rank 0 alone, on
+  // hostComm (owned; MPI_COMM_NULL on the other ranks), with the whole matrix
+  // gathered there (irnAll, jcnAll, aAll).
+  bool hostOnly = false;
+  MPI_Comm hostComm = MPI_COMM_NULL;
+  std::vector<MUMPS_INT> irnAll, jcnAll;
+  std::vector<double> aAll;
+  std::vector<int> nnzCounts, nnzOffsets;  // entries per rank (host only)
+  bool runsMumps() const { return !hostOnly || rank == 0; }
 
   // The pattern of the last analysis in global ids (this rank's rows), to tell
   // whether the next matrix has the same one, and its scratch twin.
@@ -75,11 +84,14 @@ MumpsSolver::~MumpsSolver() {
   int finalized = 0;
   MPI_Finalized(&finalized);
   if (finalized) return;  // too late to free MUMPS' memory collectively
-  impl_->id.job = -2;
-  dmumps_c(&impl_->id);
+  if (impl_->runsMumps()) {
+    impl_->id.job = -2;
+    dmumps_c(&impl_->id);
+  }
+  if (impl_->hostComm != MPI_COMM_NULL) MPI_Comm_free(&impl_->hostComm);
 }
 
-void MumpsSolver::initialize(const Teuchos::Comm<int>& comm) {
+void MumpsSolver::initialize(const Teuchos::Comm<int>& comm, bool hostOnly) {
   int initialized = 0;
   MPI_Initialized(&initialized);
   if (!initialized) throw std::logic_error("MumpsSolver: MPI is not initialised");
@@ -87,22 +99,29 @@ void MumpsSolver::initialize(const Teuchos::Comm<int>& comm) {
   impl->comm = rawComm(comm);
   MPI_Comm_rank(impl->comm, &impl->rank);
   MPI_Comm_size(impl->comm, &impl->size);
+  impl->hostOnly = hostOnly && impl->size > 1;
+  if (impl->hostOnly) MPI_Comm_split(impl->comm, impl->rank == 0 ? 0 : MPI_UNDEFINED, 0, &impl->hostComm);
   DMUMPS_STRUC_C& id = impl->id;
-  id.comm_fortran = static_cast<MUMPS_INT>(MPI_Comm_c2f(impl->comm));  // MUMPS is Fortran inside
+  id.comm_fortran = static_cast<MUMPS_INT>(MPI_Comm_c2f(impl->hostOnly ? impl->hostComm : impl->comm));  // MUMPS is Fortran inside
   id.par = 1;  // the host (rank 0) works too
   id.sym = 0;  // unsymmetric: friction
-  id.job = -1;
-  dmumps_c(&id);
-  if (INFOG(id, 1) < 0)
-    throw std::runtime_error("MUMPS initialisation failed: INFOG(1) = " + std::to_string(INFOG(id, 1)));
-  impl_ = std::move(impl);  // from here on the destructor frees MUMPS' instance
+  impl_ = std::move(impl);  // from here on the destructor frees what there is
+  run(-1);
+  if (INFOG(id, 1) < 0) {
+    const int e = INFOG(id, 1);
+    if (impl_->hostComm != MPI_COMM_NULL) MPI_Comm_free(&impl_->hostComm);
+    impl_.reset();  // no instance to free
+    throw std::runtime_error("MUMPS initialisation failed: INFOG(1) = " + std::to_string(e));
+  }
 
   if (options_.verbose) {
     ICNTL(id, 1) = 6, ICNTL(id, 2) = 0, ICNTL(id, 3) = 6, ICNTL(id, 4) = 2;
   } else {
     ICNTL(id, 1) = -1, ICNTL(id, 2) = -1, ICNTL(id, 3) = -1, ICNTL(id, 4) = 0;
   }
-  ICNTL(id, 18) = 3;  // distributed assembled matrix, pattern at analysis, values at factorisation
+  // Distributed assembled matrix, pattern at analysis, values at
+  // factorisation; host only: the whole matrix on the host.
+  ICNTL(id, 18) = impl_->hostOnly ? 0 : 3;
   ICNTL(id, 20) = 0;  // dense right-hand sides on the host
   ICNTL(id, 21) = 0;  // centralised solution (overwrites the right-hand sides)
   ICNTL(id, 8) = options_.scaling ? 77 : 0;
@@ -144,7 +163,7 @@ void MumpsSolver::factor(const CrsMatrix& A) {
   if (!A.isFillComplete() || A.isGloballyIndexed())
     throw std::invalid_argument("MumpsSolver::factor: the matrix must be fill complete");
   if (!impl_) {
-    initialize(*A.getComm());
+    initialize(*A.getComm(), long(A.getGlobalNumRows()) < options_.hostOnlyBelow);
   } else {
     int cmp = MPI_UNEQUAL;
     MPI_Comm_compare(impl_->comm, rawComm(*A.getComm()), &cmp);
@@ -208,10 +227,27 @@ void MumpsSolver::analyse(const CrsMatrix& A) {
 
   DMUMPS_STRUC_C& id = m.id;
   id.n = m.nGlobal;
-  id.nnz_loc = static_cast<MUMPS_INT8>(nnz);
-  id.irn_loc = m.irn.data();
-  id.jcn_loc = m.jcn.data();
-  id.a_loc = m.a.data();
+  if (m.hostOnly) {
+    const int mine = static_cast<int>(nnz);
+    m.nnzCounts.assign(m.size, 0);
+    m.nnzOffsets.assign(m.size, 0);
+    MPI_Gather(&mine, 1, MPI_INT, m.nnzCounts.data(), 1, MPI_INT, 0, m.comm);
+    for (int p = 1; p < m.size; ++p) m.nnzOffsets[p] = m.nnzOffsets[p - 1] + m.nnzCounts[p - 1];
+    const std::size_t all = m.rank == 0 ? std::size_t(m.nnzOffsets.back()) + m.nnzCounts.back() : 0;
+    m.irnAll.resize(all), m.jcnAll.resize(all), m.aAll.resize(all);
+    MPI_Gatherv(m.irn.data(), mine, MPI_INT, m.irnAll.data(), m.nnzCounts.data(), m.nnzOffsets.data(), MPI_INT, 0,
+                m.comm);
+    MPI_Gatherv(m.jcn.data(), mine, MPI_INT, m.jcnAll.data(), m.nnzCounts.data(), m.nnzOffsets.data(), MPI_INT, 0,
+                m.comm);
+    id.nnz = static_cast<MUMPS_INT8>(all);
+    id.irn = m.irnAll.data();
+    id.jcn = m.jcnAll.data();
+  } else {
+    id.nnz_loc = static_cast<MUMPS_INT8>(nnz);
+    id.irn_loc = m.irn.data();
+    id.jcn_loc = m.jcn.data();
+    id.a_loc = m.a.data();
+  }
   switch (options_.ordering) {
     case MumpsOptions::Ordering::Metis:
       computeMetisOrdering();
@@ -290,15 +326,19 @@ void MumpsSolver::runFactorization() {
   Impl& m = *impl_;
   DMUMPS_STRUC_C& id = m.id;
   const double t0 = MPI_Wtime();
-  id.a_loc = m.a.data();
-  id.job = 2;
-  dmumps_c(&id);
+  if (m.hostOnly) {
+    MPI_Gatherv(m.a.data(), static_cast<int>(m.a.size()), MPI_DOUBLE, m.aAll.data(), m.nnzCounts.data(),
+                m.nnzOffsets.data(), MPI_DOUBLE, 0, m.comm);
+    id.a = m.aAll.data();
+  } else {
+    id.a_loc = m.a.data();
+  }
+  run(2);
   if (INFOG(id, 1) == -8 || INFOG(id, 1) == -9) {
     // The analysis' estimate was short (delayed pivots): more room, once.
     ICNTL(id, 14) = std::max(2 * ICNTL(id, 14), ICNTL(id, 14) + 50);
     ++numWorkspaceRetries_;
-    id.job = 2;
-    dmumps_c(&id);
+    run(2);
   }
   factorSeconds_ = MPI_Wtime() - t0;
   call(0, "factorisation");  // checks the result
@@ -309,10 +349,7 @@ void MumpsSolver::runFactorization() {
 // Runs JOB = job (0: only checks the last call's result) and throws on error.
 void MumpsSolver::call(int job, const char* phase) {
   DMUMPS_STRUC_C& id = impl_->id;
-  if (job != 0) {
-    id.job = job;
-    dmumps_c(&id);
-  }
+  if (job != 0) run(job);
   const int e = INFOG(id, 1);
   if (e < 0)
     throw std::runtime_error(std::string("MUMPS ") + phase + " failed: INFOG(1) = " + std::to_string(e) +
@@ -348,6 +385,16 @@ void MumpsSolver::solve(const MultiVector& b, MultiVector& x) {
                  xj.getRawPtr(), m.nLocal, MPI_DOUBLE, 0, m.comm);
   }
   solveSeconds_ = MPI_Wtime() - t0;
+}
+
+void MumpsSolver::run(int job) {
+  Impl& m = *impl_;
+  if (m.runsMumps()) {
+    m.id.job = job;
+    dmumps_c(&m.id);
+  }
+  // Host only: the other ranks learn the outcome (and the figures) from rank 0.
+  if (m.hostOnly) MPI_Bcast(m.id.infog, 80, MPI_INT, 0, m.comm);
 }
 
 std::int64_t MumpsSolver::factorEntries() const {

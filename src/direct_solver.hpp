@@ -54,6 +54,13 @@ struct MumpsOptions {
   // core's rotation 5.5e-12 apart); threshold pivoting still guards the
   // pivots (tests/integration/direct_solvers.py checks the answers).
   bool scaling = false;
+  // Matrices with fewer rows than this are gathered onto rank 0 and factored
+  // there alone (MUMPS on a communicator of one, centralised input); larger
+  // ones are factored by all ranks. On a few thousand unknowns a factorisation
+  // shared by two ranks is dominated by their messages: the 3D drive (4,800
+  // unknowns) took 64 ms a Newton iteration on 2 ranks against 31 ms on one
+  // (docs/performance.md, "Linear solvers"). 0: always all ranks.
+  long hostOnlyBelow = 20000;
 };
 
 class MumpsSolver {
@@ -101,7 +108,8 @@ class MumpsSolver {
 
  private:
   struct Impl;  // MUMPS' structure stays out of the header
-  void initialize(const Teuchos::Comm<int>& comm);
+  void initialize(const Teuchos::Comm<int>& comm, bool hostOnly);
+  void run(int job);  // MUMPS' JOB on the ranks that run it; INFOG on every rank
   bool extractPattern(const CrsMatrix& A);  // true if this rank's pattern changed
   void analyse(const CrsMatrix& A);
   void computeMetisOrdering();

@@ -31,6 +31,15 @@ namespace {
 
 constexpr int NX = 6, NY = 5, NZ = 4, N = NX * NY * NZ;
 
+// test_mumps_2ranks_distributed sets CAPSTAN_TEST_MUMPS_DISTRIBUTED: every
+// matrix is then factored by all ranks; otherwise these small ones are
+// gathered onto rank 0 (MumpsOptions::hostOnlyBelow).
+MumpsOptions testOptions() {
+  MumpsOptions o;
+  if (std::getenv("CAPSTAN_TEST_MUMPS_DISTRIBUTED")) o.hostOnlyBelow = 0;
+  return o;
+}
+
 RCP<const Comm> worldComm() { return Tpetra::getDefaultComm(); }
 RCP<const Comm> selfComm() { return rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF)); }
 
@@ -115,7 +124,7 @@ RCP<MultiVector> solveAndCheck(MumpsSolver& solver, const CrsMatrix& A, int nrhs
 
 TEST(Mumps, SolvesConvectionDiffusionWithThreeRightHandSides) {
   auto A = convectionDiffusion(contiguousMap(N, worldComm()), ConvDiff{});
-  MumpsSolver solver;
+  MumpsSolver solver(testOptions());
   solver.factor(*A);
   solveAndCheck(solver, *A, 3);
   EXPECT_EQ(solver.numAnalyses(), 1);
@@ -185,7 +194,7 @@ TEST(Mumps, EveryOrderingSolves) {
   using O = MumpsOptions::Ordering;
   const std::pair<O, int> orderings[] = {{O::Metis, 1}, {O::Pord, 4}, {O::Amd, 0}, {O::Amf, 2}, {O::Qamd, 6}};
   for (auto [ordering, infog7] : orderings) {
-    MumpsOptions options;
+    MumpsOptions options = testOptions();
     options.ordering = ordering;
     MumpsSolver solver(options);
     solver.factor(*A);
@@ -196,7 +205,7 @@ TEST(Mumps, EveryOrderingSolves) {
 
 TEST(Mumps, RefactorisationWithTheSamePatternReusesTheAnalysis) {
   auto map = contiguousMap(N, worldComm());
-  MumpsSolver solver;
+  MumpsSolver solver(testOptions());
   auto A1 = convectionDiffusion(map, ConvDiff{});
   solver.factor(*A1);
   solveAndCheck(solver, *A1, 3);
@@ -226,7 +235,7 @@ TEST(Mumps, RefactorisationWithTheSamePatternReusesTheAnalysis) {
 
 TEST(Mumps, ChangedPatternGetsANewAnalysis) {
   auto map = contiguousMap(N, worldComm());
-  MumpsSolver solver;
+  MumpsSolver solver(testOptions());
   auto A1 = convectionDiffusion(map, ConvDiff{});
   solver.factor(*A1);
   auto A2 = convectionDiffusion(map, ConvDiff{1.0, 1.0, true});
@@ -245,7 +254,7 @@ TEST(Mumps, NonContiguousMapAndOneRankAgree) {
   // one-rank solve of the same system on MPI_COMM_SELF: the same x.
   const ConvDiff c{2.0, 0.0, true};
   auto A = convectionDiffusion(cyclicReversedMap(N, worldComm()), c);
-  MumpsSolver solver;
+  MumpsSolver solver(testOptions());
   solver.factor(*A);
   auto x = solveAndCheck(solver, *A, 3);
 
@@ -265,7 +274,7 @@ TEST(Mumps, NonContiguousMapAndOneRankAgree) {
 
 TEST(Mumps, SingularMatricesThrowAndTheSolverRecovers) {
   auto map = contiguousMap(N, worldComm());
-  MumpsSolver solver;
+  MumpsSolver solver(testOptions());
   {
     // Numerically singular: one row's values all zero, the pattern intact.
     auto A = convectionDiffusion(map, ConvDiff{});
@@ -362,7 +371,7 @@ RCP<CrsMatrix> saddlePoint(RCP<const Map> map) {
 
 TEST(Mumps, ZeroDiagonalBlockSolvesWithoutWorkspaceMargin) {
   auto A = saddlePoint(contiguousMap(N + N / 4, worldComm()));
-  MumpsOptions options;
+  MumpsOptions options = testOptions();
   options.workspaceIncreasePercent = 0;
   MumpsSolver solver(options);
   solver.factor(*A);
@@ -374,7 +383,7 @@ TEST(Mumps, ZeroDiagonalBlockSolvesWithoutWorkspaceMargin) {
 TEST(Mumps, MismatchedVectorsThrow) {
   auto map = contiguousMap(N, worldComm());
   auto A = convectionDiffusion(map, ConvDiff{});
-  MumpsSolver solver;
+  MumpsSolver solver(testOptions());
   MultiVector b(map, 2), x(map, 3);
   EXPECT_THROW(solver.solve(b, b), std::logic_error);  // nothing factorised
   solver.factor(*A);
@@ -444,7 +453,7 @@ MumpsOptions::Ordering orderingFromEnv() {
 
 void timeElasticity(int n) {
   auto A = elasticityLike(n, worldComm());
-  MumpsOptions options;
+  MumpsOptions options = testOptions();
   options.ordering = orderingFromEnv();
   MumpsSolver solver(options);
   solver.factor(*A);
