@@ -306,7 +306,15 @@ Teuchos::ParameterList stratimikosParameters(const SolverSettings& solver, int r
         const auto& user = strat.sublist("Preconditioner Types").sublist("MueLu");
         if (user.isType<std::string>("smoother: type")) userSmoother = user.get<std::string>("smoother: type");
       }
-      if (userSmoother == "CHEBYSHEV") {
+      if (userSmoother == "CHEBYSHEV" && solver.gradedRings) {
+        // Graded rings (an annulus): symmetric Gauss-Seidel, two sweeps, and
+        // weak connections dropped. The Hertz ring: 654 Krylov iterations
+        // against 2,746 with Chebyshev, 2.6-2.8x faster (docs/performance.md).
+        ml.set("smoother: type", "RELAXATION");
+        ml.sublist("smoother: params").set("relaxation: type", "Symmetric Gauss-Seidel");
+        ml.sublist("smoother: params").set("relaxation: sweeps", 2);
+        ml.set("aggregation: drop tol", 0.05);
+      } else if (userSmoother == "CHEBYSHEV") {
         ml.set("smoother: type", "CHEBYSHEV");
         ml.sublist("smoother: params").set("chebyshev: degree", 2);
       }

@@ -121,6 +121,7 @@ SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterRe
 
 SolverSettings SolverSettings::resolved(long dofs, bool annulus, bool friction) const {
   SolverSettings s = *this;
+  s.gradedRings = gradedRings || annulus;  // NewtonSolver resolves again, knowing no mesh
   if (s.linearSolver == LinearSolver::Auto) {
     const long most = s.directSolverMaxDofs > 0 ? s.directSolverMaxDofs : annulus ? 50000 : 5000;
     if (dofs > most) {

@@ -42,6 +42,9 @@ struct SolverSettings {
   Schur pressureStepSchur{};
   int pressureAccelerationDepth = 0;
   double minimumSolvePenalty = 0;  // resolved: > 0
+  // Set by resolved() for an annulus: MueLu with symmetric Gauss-Seidel
+  // smoothing and a drop tolerance, which suit graded rings (src/newton.cpp).
+  bool gradedRings = false;
   Teuchos::ParameterList nox, stratimikos;  // passed to NOX and Stratimikos over capstan's defaults
 
   static void declare(Teuchos::ParameterList& solver);

@@ -683,6 +683,9 @@ TEST(SolverSettings, AutoResolvesByKindAndSize) {
   EXPECT_EQ(pick(s, 15120, true, false), std::make_pair(S::LinearSolver::GMRES, S::Preconditioner::LU));
   EXPECT_EQ(pick(s, 50001, true, false), std::make_pair(S::LinearSolver::GMRES, S::Preconditioner::MueLu));
   EXPECT_EQ(pick(s, 500, true, false).second, S::Preconditioner::LU);
+  EXPECT_TRUE(s.resolved(60000, true, false).gradedRings) << "an annulus' MueLu smooths for graded rings";
+  EXPECT_FALSE(s.resolved(60000, false, false).gradedRings);
+  EXPECT_TRUE(s.resolved(60000, true, false).resolved(60000, false, false).gradedRings) << "kept when resolved again";
   // A scene's own choices stay; a positive Direct Solver Max Dofs applies to both meshes.
   S own = s;
   own.preconditioner = S::Preconditioner::ILU;
