@@ -63,6 +63,10 @@ struct MumpsSolver::Impl {
   // whether the next matrix has the same one, and its scratch twin.
   std::vector<GO> rowGid, colGid, newRowGid, newColGid;
   std::vector<std::size_t> rowPtr, newRowPtr;
+  // The graph of the last matrix: a fill-complete Tpetra graph does not change,
+  // so the same graph object again means the same pattern (only values are
+  // read). Held, so that no later graph can take its address.
+  RCP<const Tpetra::RowGraph<LO, GO>> graph;
 
   // What MUMPS reads: 1-based global row / column numbers and the values.
   // Rows are numbered rank by rank in local order (rank r's rows are
@@ -131,16 +135,31 @@ void MumpsSolver::initialize(const Teuchos::Comm<int>& comm, bool hostOnly) {
 
 bool MumpsSolver::extractPattern(const CrsMatrix& A) {
   Impl& m = *impl_;
+  const LO nRows = static_cast<LO>(A.getNodeNumRows());
+  CrsMatrix::local_inds_host_view_type inds;
+  CrsMatrix::values_host_view_type vals;
+  const auto graph = A.getCrsGraph();
+  if (graph.get() == m.graph.get() && std::size_t(nRows) + 1 == m.rowPtr.size()) {
+    // Newton's matrix again: its values only (2.6 -> 0.4 ms of each of the 3D
+    // drive's factorisations, 1.3 M factor entries, 26 ms). A resumed fill can
+    // only add entries, so equal row lengths mean the same pattern.
+    m.a.resize(m.rowPtr.back());
+    bool same = true;
+    for (LO r = 0; r < nRows && same; ++r) {
+      A.getLocalRowView(r, inds, vals);
+      same = vals.extent(0) == m.rowPtr[r + 1] - m.rowPtr[r];
+      if (same) std::copy(vals.data(), vals.data() + vals.extent(0), m.a.begin() + m.rowPtr[r]);
+    }
+    if (same) return false;
+  }
+  m.graph = graph;
   const auto& rowMap = *A.getRowMap();
   const auto& colMap = *A.getColMap();
-  const LO nRows = static_cast<LO>(A.getNodeNumRows());
   m.newRowGid.resize(nRows);
   m.newRowPtr.resize(nRows + 1);
   m.newColGid.clear();
   m.a.clear();
   m.newRowPtr[0] = 0;
-  CrsMatrix::local_inds_host_view_type inds;
-  CrsMatrix::values_host_view_type vals;
   for (LO r = 0; r < nRows; ++r) {
     A.getLocalRowView(r, inds, vals);
     m.newRowGid[r] = rowMap.getGlobalElement(r);
