@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """capstan runs with glibc malloc settings of its own (src/heap_tunables.hpp).
 
-The driver runs itself again at start-up with GLIBC_TUNABLES naming
+The launcher (build/capstan) starts the solver program with GLIBC_TUNABLES naming
 glibc.malloc.hugetlb=1 (the heap in transparent huge pages), glibc.malloc.mmap_max=0
 and a large glibc.malloc.trim_threshold (freed memory stays with the process, so
 the GMRES basis and MueLu's matrices, allocated anew for every solve and set-up,
