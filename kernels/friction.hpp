@@ -76,6 +76,10 @@ struct FrictionPoint {
   int state = 0;                   // 0 no contact, 1 stick, 2 slip
   double weight = 0;               // quadrature weight x reference area element
   double e[3] = {0, 0, 0};         // unit vector from the axis towards the point
+  // Work dissipated in the increment per reference area, t . (plastic slip):
+  // t . du_t for the regularised laws; Coulomb t . (du_t - eps_t (t - h)),
+  // zero while sticking (the rest of du_t is the elastic slip).
+  double work = 0;
 };
 
 // Residual (R_a = -sum_q w N_a t_f) and tangent (if K is not null) of one face.
@@ -217,6 +221,17 @@ KOKKOS_INLINE_FUNCTION bool frictionFaceResidualTangent(
       }
     }
     for (int i = 0; i < 3; ++i) p.traction[i] = t[i];
+    p.work = 0;
+    if (fp.law == FrictionLaw::Coulomb) {  // t . (du_t - eps_t (t - h_t)) = eps_t t . (t* - t)
+      const double* h = history + 3 * q;
+      const double eh = e[0] * h[0] + e[1] * h[1] + e[2] * h[2];
+      for (int i = 0; i < 3; ++i) {
+        const double trial = h[i] - eh * e[i] + dut[i] / fp.tangentPenalty;
+        p.work += fp.tangentPenalty * t[i] * (trial - t[i]);
+      }
+    } else {
+      for (int i = 0; i < 3; ++i) p.work += t[i] * dut[i];
+    }
     for (int a = 0; a < 4; ++a)
       for (int i = 0; i < 3; ++i) R[3 * a + i] -= p.weight * N[a] * t[i];
     if (!K) continue;

@@ -21,7 +21,7 @@ namespace capstan::checkpoint {
 
 namespace fs = std::filesystem;
 
-inline const char* kMagic = "capstan checkpoint 3";
+inline const char* kMagic = "capstan checkpoint 4";
 
 class Writer {
  public:

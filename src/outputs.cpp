@@ -272,6 +272,7 @@ void Outputs::writeSummary(const std::vector<StepRecord>& steps, bool converged,
   top.add("title", json::string(m_.scene.title)).add("scene", json::string(m_.scene.file))
       .add("version", json::string(CAPSTAN_VERSION))
       .add("ranks", json::number(m_.comm->getSize()))
+      .add("analysis", json::string("Quasi-Static"))  // interface.md, "Steady rolling"
       .add("converged", converged ? "true" : "false")
       .add("failure", converged ? "null" : json::string(failure))
       .add("mesh", meshObject.str()).add("steps", stepList).add("final", fin.str())

@@ -19,7 +19,7 @@ RigidCores::RigidCores(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
     RigidCore core;
     core.name = s.name;
     core.axisPoint = s.axisPoint, core.axisDirection = s.axisDirection, core.force = s.force;
-    core.torque = s.torque, core.rampTime = s.rampTime;
+    core.torque = s.torque, core.rampTime = s.rampTime, core.torqueRampTime = s.torqueRampTime;
     core.free = {s.freeTranslation[0], s.freeTranslation[1], s.freeTranslation[2], s.rotation == SupportSpec::Rotation::Free};
     core.firstDof = nodeDofs + 6 * int(cores_.size());
     for (int n : mesh.faceNodes(s.face))

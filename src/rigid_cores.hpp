@@ -28,7 +28,7 @@ class Constraints;
 struct RigidCore {
   std::string name;
   std::array<double, 3> axisPoint{}, axisDirection{}, force{};
-  double torque = 0, rampTime = 1;
+  double torque = 0, rampTime = 1, torqueRampTime = 1;
   std::array<bool, 4> free{};  // Tx Ty Tz theta
   int support = -1;            // its support id in Constraints
   int firstDof = 0;            // assembly dof of Tx
@@ -39,8 +39,10 @@ struct RigidCore {
   std::array<double, 3> forceOnBody{};
   double torqueOnBody = 0;
   double geometric = 0;  // sum over the face's nodes of R . w (the theta-theta tangent term)
-  // External loads at time t: ramped linearly to rampTime, then held.
+  // External loads at time t: ramped linearly to rampTime (the torque to
+  // torqueRampTime), then held.
   double loadFactor(double t) const { return std::min(1.0, t / rampTime); }
+  double torqueFactor(double t) const { return std::min(1.0, t / torqueRampTime); }
 };
 
 class RigidCores {
@@ -87,8 +89,8 @@ class RigidCores {
   double residual(int dof, double t) const {
     const auto& core = cores_[(dof - layout_.nodeDofs) / 6];
     const int j = (dof - layout_.nodeDofs) % 6;
-    const double load = core.loadFactor(t);
-    return j < 3 ? core.forceOnBody[j] - load * core.force[j] : core.torqueOnBody - load * core.torque;
+    return j < 3 ? core.forceOnBody[j] - core.loadFactor(t) * core.force[j]
+                 : core.torqueOnBody - core.torqueFactor(t) * core.torque;
   }
 
   // The matrix graph. findCoupling: each stiff effect's entities with a face

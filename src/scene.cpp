@@ -712,6 +712,8 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
   rejectSingularCores(sc, v);
   for (auto& s : sc.supports)
     if (s.isCore() && s.rampTime == 0) s.rampTime = sc.stepSize;
+  for (auto& s : sc.supports)
+    if (s.isCore() && s.torqueRampTime == 0) s.torqueRampTime = s.rampTime;
 
   const bool friction = std::any_of(sc.capstans.begin(), sc.capstans.end(),
                                     [](const CapstanSpec& c) { return c.friction.on(); });

@@ -34,6 +34,7 @@ struct CapstanRecord {
   bool friction = false;
   long stick = 0, slip = 0;
   double frictionIntegral = 0, normalIntegral = 0, maxFrictionRatio = 0;
+  double slipPower = 0;  // friction dissipation in the nip (>= 0; 0 without friction)
 };
 
 // A support's figures at a converged step (global). Rigid cores add their
@@ -70,6 +71,7 @@ void walkCapstan(V& v, C& c) {
   v.field("contact_area", c.area);
   v.field("peak_pressure", c.peakPressure);
   v.field("contact_width", c.width);
+  v.field("slip_power", c.slipPower);
   v.group("friction", c.friction, [&] {
     v.field("traction_integral", c.frictionIntegral);
     v.field("normal_traction_integral", c.normalIntegral);

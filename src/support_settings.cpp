@@ -21,7 +21,7 @@ const std::vector<std::pair<const char*, SupportSpec::Rotation>> SupportSpec::ro
 namespace {
 Array<double> vec3(double a, double b, double c) { return Teuchos::tuple(a, b, c); }
 const char* kCoreOnly[] = {"Axis Point", "Axis Direction", "Free Translation", "Force", "Force Ramp Time",
-                           "Rotation", "Torque", "Angular Velocity"};
+                           "Rotation", "Torque", "Torque Ramp Time", "Angular Velocity"};
 }  // namespace
 
 void SupportSpec::declare(Teuchos::ParameterList& s) {
@@ -42,7 +42,10 @@ void SupportSpec::declare(Teuchos::ParameterList& s) {
   s.set("Rotation", std::string("Fixed"), "Rigid Core: Fixed | Free | Prescribed (about the axis)");
   s.set("Torque", 0.0,
         "Rigid Core, Rotation = Free: external torque on the core about its axis (right-hand rule; "
-        "a brake acts against the rotation), ramped like Force");
+        "a brake acts against the rotation), ramped to Torque Ramp Time");
+  s.set("Torque Ramp Time", 0.0,
+        "Rigid Core: Torque grows linearly from 0 and is reached at this time (> 0), then held; "
+        "0 = Force Ramp Time. A brake sweep is one run whose Torque Ramp Time is its last step's time");
   s.set("Angular Velocity", 0.0, "Rigid Core, Rotation = Prescribed: rad per unit time, right-hand rule");
 }
 
@@ -82,6 +85,7 @@ void readRigidCore(const Teuchos::ParameterList& s, const std::string& path, con
   spec.rotation = r.choice(s, path, "Rotation", SupportSpec::rotations);
   const std::string rotation = nameOf(spec.rotation, SupportSpec::rotations);
   spec.torque = r.finite(s, path, "Torque");
+  spec.torqueRampTime = r.nonNegative(s, path, "Torque Ramp Time");
   if (spec.torque != 0 && spec.rotation != Rotation::Free)
     r.fail(path + "/Torque", "an applied torque needs Rotation = Free (it is '" + rotation + "')");
   spec.angularVelocity = r.finite(s, path, "Angular Velocity");

@@ -33,7 +33,8 @@ struct SupportSpec {
   std::array<double, 3> force{};       // external force on the core, ramped to rampTime
   double rampTime = 0;                 // > 0 once the scene is read (0: the first step's end)
   Rotation rotation = Rotation::Fixed;
-  double torque = 0;                   // Free: external torque on the core, ramped like force
+  double torque = 0;                   // Free: external torque on the core, ramped to torqueRampTime
+  double torqueRampTime = 0;           // > 0 once the scene is read (0: rampTime)
   double angularVelocity = 0;          // Prescribed
 
   bool isCore() const { return type == Type::RigidCore; }

@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "assembly.hpp"
+#include "errors.hpp"
 #include "scene.hpp"
 
 using namespace capstan;
@@ -169,3 +170,25 @@ TEST(RigidCore, RigidMotionLeavesNoResidual) {
 }
 
 }  // namespace
+
+// Force and Torque ramp apart (Torque Ramp Time, default Force Ramp Time,
+// whose default is the first step's end): a brake sweep is one run.
+TEST(RigidCore, TorqueRampsToItsOwnTime) {
+  auto core = [](const std::vector<std::string>& sets) {
+    return parseScene(kScene, "rigid-core-test.xml", sets, "").supports.at(0);
+  };
+  EXPECT_EQ(core({}).rampTime, 1.0);
+  EXPECT_EQ(core({}).torqueRampTime, 1.0);
+  EXPECT_EQ(core({"Supports/core/Force Ramp Time=3"}).torqueRampTime, 3.0);
+  const SupportSpec s = core({"Supports/core/Force Ramp Time=2", "Supports/core/Torque Ramp Time=5"});
+  EXPECT_EQ(s.rampTime, 2.0);
+  EXPECT_EQ(s.torqueRampTime, 5.0);
+  EXPECT_THROW(core({"Supports/core/Torque Ramp Time=-1"}), InputError);
+  RigidCore c;
+  c.rampTime = s.rampTime, c.torqueRampTime = s.torqueRampTime;
+  EXPECT_DOUBLE_EQ(c.loadFactor(1.0), 0.5);
+  EXPECT_DOUBLE_EQ(c.torqueFactor(1.0), 0.2);
+  EXPECT_DOUBLE_EQ(c.loadFactor(4.0), 1.0);
+  EXPECT_DOUBLE_EQ(c.torqueFactor(4.0), 0.8);
+  EXPECT_DOUBLE_EQ(c.torqueFactor(6.0), 1.0);
+}

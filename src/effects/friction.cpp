@@ -23,7 +23,7 @@ static_assert(int(FrictionSettings::Law::Tanh) == int(kernels::FrictionLaw::Tanh
 
 namespace {
 constexpr int kHistoryPerFace = 12 + 3 * kernels::kMaxFacePoints;
-enum FrictionField { kTraction = 0, kNormal = 3, kSlip, kState, kFWeight, kFE };
+enum FrictionField { kTraction = 0, kNormal = 3, kSlip, kState, kFWeight, kFE, kWork = kFE + 3 };
 }  // namespace
 
 FrictionEffect::FrictionEffect(const std::string& name, const Mesh& mesh,
@@ -56,6 +56,7 @@ FrictionEffect::FrictionEffect(const std::string& name, const Mesh& mesh,
 
 void FrictionEffect::setInterval(double tStart, double tEnd) {
   const double dt = tEnd - tStart;
+  dt_ = dt;
   for (int i = 0; i < 3; ++i) parameters_.ds[i] = contact_.capstan().velocity[i] * dt;
   parameters_.spin = contact_.capstan().angularVelocity * dt * contact_.radius();
   // The slip-length scale eps3 dt; a zero-length interval (a re-evaluation of a
@@ -101,6 +102,7 @@ void FrictionEffect::launch(const NodalVectors& x, const NodalVectors&, bool tan
           pts(f, q, kState) = p[q].state;
           pts(f, q, kFWeight) = p[q].weight;
           for (int i = 0; i < 3; ++i) pts(f, q, kFE + i) = p[q].e[i];
+          pts(f, q, kWork) = p[q].work;
         }
       });
 }
@@ -175,6 +177,7 @@ FrictionEffect::Figures FrictionEffect::figures() const {
       const double* t = &pts(f, q, kTraction);
       const double mag = std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
       fig.frictionIntegral += w * mag;
+      fig.work += w * pts(f, q, kWork);
       fig.normalIntegral += w * tn;
       if (settings_.coefficient > 0) fig.maxRatio = std::max(fig.maxRatio, mag / (settings_.coefficient * tn));
       // Force on the capstan -w t at radius R e: axial moment R (e x F) . b = R F . (b x e).
@@ -230,6 +233,11 @@ void FrictionEffect::report(const Teuchos::Comm<int>& comm, StepRecord& rec) con
   r->stick = long(gs[6]);
   r->slip = long(gs[7]);
   r->maxFrictionRatio = ratio;
+  // The increment's dissipated work over its length; a re-evaluation of a
+  // converged state (a zero-length interval) has no slip.
+  double work = 0;
+  Teuchos::reduceAll(comm, Teuchos::REDUCE_SUM, ff.work, Teuchos::outArg(work));
+  r->slipPower = dt_ > 0 ? work / dt_ : 0.0;
 }
 
 }  // namespace capstan

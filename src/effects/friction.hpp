@@ -49,6 +49,7 @@ class FrictionEffect : public Effect {
     double frictionIntegral = 0;    // sum of w |t_f|
     double normalIntegral = 0;      // sum of w t_n
     double maxRatio = 0;            // largest |t_f| / (mu t_n)
+    double work = 0;                // sum of w x the work dissipated in the increment
   };
   Figures figures() const;
   // Per face: mean friction traction (3), stick and slip point counts.
@@ -66,9 +67,10 @@ class FrictionEffect : public Effect {
   // [face][12 + 3q + i]: Coulomb's traction at point q from that state.
   Kokkos::View<double*> history_;
   Kokkos::View<double*> tangentialMultipliers_;  // [(face * kMaxFacePoints + q) * 3 + i]
-  // Per face and point at the last evaluation: traction (3), t_n, slip, state, weight, e (3).
-  Kokkos::View<double** [10], Kokkos::LayoutRight> points_;
+  // Per face and point at the last evaluation: traction (3), t_n, slip, state, weight, e (3), work.
+  Kokkos::View<double** [11], Kokkos::LayoutRight> points_;
   FrictionSettings settings_;
+  double dt_ = 0;  // the increment's length (setInterval)
   kernels::FrictionParameters parameters_;
 };
 

@@ -17,7 +17,12 @@ inputs/seed/h1.xml ... h5.xml).
   * H4 (k = 0.1) and H5 (mu = 0.9), capstan's method (augmented Lagrangian, Coulomb):
     converge with max_penetration below 1e-3 at every step, the friction traction never
     above mu t_n (ratio <= 1 + 1e-8), no NaN; the study's loosened penalties
-    (h4-study.xml, h5-study.xml) are run and their penetrations printed beside them.
+    (h4-study.xml, h5-study.xml) are run and their penetrations printed beside them;
+  * power (summary.json slip_power, the friction dissipation; interface.md "Steady
+    rolling"): >= 0 at every step, at most the power the capstan delivers (-torque x
+    omega: the rest goes into the body), and equal to it (1e-8) in the steps of steady
+    full slip, where the body stands still (H1 steps 2-4 with tanh, H5 steps 3-4 with
+    Coulomb); summary.json names its analysis, Quasi-Static.
 """
 import os
 import sys
@@ -54,6 +59,22 @@ def run(name, sets=(), tag=None):
     return s
 
 
+OMEGA = 12.5  # the capstan's angular velocity in h1.xml and h5.xml
+
+
+def check_power(name, s, steady_steps):
+    """slip_power against the capstan's power -torque x omega (see the docstring)."""
+    T.check(s.get("analysis") == "Quasi-Static", f"{name}: summary.json analysis {s.get('analysis')!r}")
+    for st in s["steps"]:
+        c = st["capstans"]["capstan"]
+        sp, delivered = c["slip_power"], -c["torque"] * OMEGA
+        T.check(-1e-12 <= sp <= delivered * (1 + 1e-10),
+                f"{name} step {st['step']}: 0 <= slip_power {sp:.10g} <= capstan power {delivered:.10g}")
+        if st["step"] in steady_steps:
+            T.check(abs(sp - delivered) <= 1e-8 * delivered,
+                    f"{name} step {st['step']} (steady full slip): slip_power {sp:.12g} = capstan power {delivered:.12g}")
+
+
 def final(s):
     return (s["steps"][-1]["capstans"]["capstan"]["force"][0], s["final"]["node_displacement_mean"]["xmin"][0])
 
@@ -71,6 +92,9 @@ if h1:
         T.check(abs(ratio - 1) <= 1e-6, f"H1 step {st['step']}: friction integral / (mu x normal integral) = {ratio:.9f}")
         T.check(c["slip_points"] == c["contact_points"] > 0 and c["stick_points"] == 0,
                 f"H1 step {st['step']}: all {c['contact_points']} contact points slip ({c['slip_points']})")
+
+if h1:
+    check_power("H1", h1, (2, 3, 4))
 
 h2 = run("h2")
 if h1 and h2:
@@ -96,6 +120,8 @@ for name in ("h4", "h5"):
         ratio = max(st["capstans"]["capstan"]["friction"]["max_traction_ratio"] for st in s["steps"])
         T.check(worst < 1e-3, f"{name}: max_penetration {worst:.2e} < 1e-3 at every step")
         T.check(ratio <= 1 + 1e-8, f"{name}: |t_f| / (mu t_n) <= {ratio:.12f} (<= 1 + 1e-8)")
+        if name == "h5":
+            check_power("H5", s, (3, 4))
     if study:
         pen = max(st["capstans"]["capstan"]["max_penetration"] for st in study["steps"])
         print(f"    {name}-study: the study's loosened penalty lets the capstan in by {pen:.4f} "
