@@ -16,7 +16,7 @@ using Teuchos::rcp;
 namespace {
 
 using ConverterT = Thyra::TpetraOperatorVectorExtraction<double>;
-using Shared = MumpsSolveFactory::Shared;
+using Shared = MumpsShared;
 
 // An operator with its factorisation in the shared solver.
 class MumpsLinearOpWithSolve : public Thyra::LinearOpWithSolveBase<double> {
@@ -126,7 +126,9 @@ const std::vector<std::pair<const char*, MumpsOptions::Ordering>> kOrderings = {
     {"AMD", MumpsOptions::Ordering::Amd},     {"AMF", MumpsOptions::Ordering::Amf},
     {"QAMD", MumpsOptions::Ordering::Qamd}};
 
-RCP<const Teuchos::ParameterList> validOptions() {
+}  // namespace
+
+RCP<const Teuchos::ParameterList> validMumpsOptions() {
   static RCP<Teuchos::ParameterList> valid;
   if (valid.is_null()) {
     valid = Teuchos::parameterList("MUMPS");
@@ -141,8 +143,8 @@ RCP<const Teuchos::ParameterList> validOptions() {
 
 // The factories' parameter list into the shared options (the next
 // factorisation uses them).
-void readOptions(Teuchos::ParameterList& list, Shared& shared) {
-  list.validateParametersAndSetDefaults(*validOptions(), 0);
+void readMumpsOptions(Teuchos::ParameterList& list, MumpsShared& shared) {
+  list.validateParametersAndSetDefaults(*validMumpsOptions(), 0);
   const auto ordering = list.get<std::string>("Ordering");
   bool known = false;
   for (const auto& [name, value] : kOrderings)
@@ -153,10 +155,6 @@ void readOptions(Teuchos::ParameterList& list, Shared& shared) {
   shared.solver.reset();
   shared.factoredFor = nullptr;
 }
-
-}  // namespace
-
-MumpsSolveFactory::MumpsSolveFactory() : shared_(std::make_shared<Shared>()) {}
 
 bool MumpsSolveFactory::isCompatible(const Thyra::LinearOpSourceBase<double>& src) const {
   auto op = ConverterT::getConstTpetraOperator(src.getOp());
@@ -190,22 +188,6 @@ void MumpsSolveFactory::uninitializeOp(Thyra::LinearOpWithSolveBase<double>* op,
   if (approx) *approx = Teuchos::null;
 }
 
-RCP<const Teuchos::ParameterList> MumpsSolveFactory::getValidParameters() const { return validOptions(); }
-
-
-void MumpsSolveFactory::setParameterList(const RCP<Teuchos::ParameterList>& list) {
-  readOptions(*list, *shared_);
-  list_ = list;
-}
-
-RCP<Teuchos::ParameterList> MumpsSolveFactory::unsetParameterList() {
-  auto old = list_;
-  list_ = Teuchos::null;
-  return old;
-}
-
-MumpsPreconditionerFactory::MumpsPreconditionerFactory() : shared_(std::make_shared<Shared>()) {}
-
 bool MumpsPreconditionerFactory::isCompatible(const Thyra::LinearOpSourceBase<double>& src) const {
   auto op = ConverterT::getConstTpetraOperator(src.getOp());
   return !Teuchos::rcp_dynamic_cast<const MumpsSolver::CrsMatrix>(op).is_null();
@@ -231,18 +213,5 @@ void MumpsPreconditionerFactory::uninitializePrec(Thyra::PreconditionerBase<doub
   if (src) *src = op.is_null() ? Teuchos::null : Thyra::defaultLinearOpSource<double>(op->forward());
   p.uninitialize();
 }
-
-void MumpsPreconditionerFactory::setParameterList(const RCP<Teuchos::ParameterList>& list) {
-  readOptions(*list, *shared_);
-  list_ = list;
-}
-
-RCP<Teuchos::ParameterList> MumpsPreconditionerFactory::unsetParameterList() {
-  auto old = list_;
-  list_ = Teuchos::null;
-  return old;
-}
-
-RCP<const Teuchos::ParameterList> MumpsPreconditionerFactory::getValidParameters() const { return validOptions(); }
 
 }  // namespace capstan

@@ -15,10 +15,44 @@
 
 namespace capstan {
 
-class MumpsSolveFactory : public Thyra::LinearOpWithSolveFactoryBase<double> {
- public:
-  MumpsSolveFactory();
+// What the factories share: one MUMPS instance for every operator they
+// initialise, and which operator's values it holds.
+struct MumpsShared {
+  MumpsOptions options;
+  std::unique_ptr<MumpsSolver> solver;  // created on first use
+  const void* factoredFor = nullptr;    // the operator whose values are factored
+};
 
+// The parameters both factories take: "Ordering" (Metis | Pord | AMD | AMF |
+// QAMD), "Verbose", "Scaling" (MumpsOptions).
+Teuchos::RCP<const Teuchos::ParameterList> validMumpsOptions();
+void readMumpsOptions(Teuchos::ParameterList& list, MumpsShared& shared);
+
+template <class Base>
+class MumpsParameters : public Base {
+ public:
+  void setParameterList(const Teuchos::RCP<Teuchos::ParameterList>& list) override {
+    readMumpsOptions(*list, *shared_);
+    list_ = list;
+  }
+  Teuchos::RCP<Teuchos::ParameterList> getNonconstParameterList() override { return list_; }
+  Teuchos::RCP<Teuchos::ParameterList> unsetParameterList() override {
+    auto old = list_;
+    list_ = Teuchos::null;
+    return old;
+  }
+  Teuchos::RCP<const Teuchos::ParameterList> getParameterList() const override { return list_; }
+  Teuchos::RCP<const Teuchos::ParameterList> getValidParameters() const override { return validMumpsOptions(); }
+  // The shared solver (counters, timings, memory).
+  const std::shared_ptr<MumpsShared>& shared() const { return shared_; }
+
+ protected:
+  std::shared_ptr<MumpsShared> shared_ = std::make_shared<MumpsShared>();
+  Teuchos::RCP<Teuchos::ParameterList> list_;
+};
+
+class MumpsSolveFactory : public MumpsParameters<Thyra::LinearOpWithSolveFactoryBase<double>> {
+ public:
   bool isCompatible(const Thyra::LinearOpSourceBase<double>& fwdOpSrc) const override;
   Teuchos::RCP<Thyra::LinearOpWithSolveBase<double>> createOp() const override;
   void initializeOp(const Teuchos::RCP<const Thyra::LinearOpSourceBase<double>>& fwdOpSrc,
@@ -34,26 +68,7 @@ class MumpsSolveFactory : public Thyra::LinearOpWithSolveFactoryBase<double> {
                       Teuchos::RCP<const Thyra::PreconditionerBase<double>>* prec,
                       Teuchos::RCP<const Thyra::LinearOpSourceBase<double>>* approxFwdOpSrc,
                       Thyra::ESupportSolveUse* use) const override;
-
-  // Parameters: "Ordering" (Metis | Pord | AMD | AMF | QAMD), "Verbose".
-  void setParameterList(const Teuchos::RCP<Teuchos::ParameterList>& list) override;
-  Teuchos::RCP<Teuchos::ParameterList> getNonconstParameterList() override { return list_; }
-  Teuchos::RCP<Teuchos::ParameterList> unsetParameterList() override;
-  Teuchos::RCP<const Teuchos::ParameterList> getParameterList() const override { return list_; }
-  Teuchos::RCP<const Teuchos::ParameterList> getValidParameters() const override;
   std::string description() const override { return "capstan::MumpsSolveFactory"; }
-
-  // The shared solver (counters, timings, memory); created on first use.
-  struct Shared {
-    MumpsOptions options;
-    std::unique_ptr<MumpsSolver> solver;
-    const void* factoredFor = nullptr;  // the operator whose values are factored
-  };
-  const std::shared_ptr<Shared>& shared() const { return shared_; }
-
- private:
-  std::shared_ptr<Shared> shared_;
-  Teuchos::RCP<Teuchos::ParameterList> list_;
 };
 
 // A MUMPS factorisation as a preconditioner (Stratimikos' "Preconditioner
@@ -62,9 +77,8 @@ class MumpsSolveFactory : public Thyra::LinearOpWithSolveFactoryBase<double> {
 // factorisation kept over several iterations (Solver/Preconditioner Reuse)
 // still makes GMRES converge in a few iterations, each a pair of triangular
 // solves, much cheaper than a new factorisation (docs/performance.md).
-class MumpsPreconditionerFactory : public Thyra::PreconditionerFactoryBase<double> {
+class MumpsPreconditionerFactory : public MumpsParameters<Thyra::PreconditionerFactoryBase<double>> {
  public:
-  MumpsPreconditionerFactory();
   bool isCompatible(const Thyra::LinearOpSourceBase<double>& fwdOpSrc) const override;
   Teuchos::RCP<Thyra::PreconditionerBase<double>> createPrec() const override;
   void initializePrec(const Teuchos::RCP<const Thyra::LinearOpSourceBase<double>>& fwdOpSrc,
@@ -72,17 +86,7 @@ class MumpsPreconditionerFactory : public Thyra::PreconditionerFactoryBase<doubl
   void uninitializePrec(Thyra::PreconditionerBase<double>* prec,
                         Teuchos::RCP<const Thyra::LinearOpSourceBase<double>>* fwdOpSrc,
                         Thyra::ESupportSolveUse* use) const override;
-  void setParameterList(const Teuchos::RCP<Teuchos::ParameterList>& list) override;
-  Teuchos::RCP<Teuchos::ParameterList> getNonconstParameterList() override { return list_; }
-  Teuchos::RCP<Teuchos::ParameterList> unsetParameterList() override;
-  Teuchos::RCP<const Teuchos::ParameterList> getParameterList() const override { return list_; }
-  Teuchos::RCP<const Teuchos::ParameterList> getValidParameters() const override;
   std::string description() const override { return "capstan::MumpsPreconditionerFactory"; }
-  const std::shared_ptr<MumpsSolveFactory::Shared>& shared() const { return shared_; }
-
- private:
-  std::shared_ptr<MumpsSolveFactory::Shared> shared_;
-  Teuchos::RCP<Teuchos::ParameterList> list_;
 };
 
 }  // namespace capstan
