@@ -42,7 +42,6 @@ class Assembly {
   const Constraints& constraints() const { return constraints_; }
   BrickEffect& bricks() { return *effects_.bricks; }
   const std::vector<std::unique_ptr<Effect>>& effects() const { return effects_.all; }
-  const std::vector<FoundationEffect*>& foundations() const { return effects_.foundations; }
   const std::vector<ContactEffect*>& contacts() const { return effects_.contacts; }
   // Per capstan (as contacts()): its friction effect, or null without friction.
   const std::vector<FrictionEffect*>& frictions() const { return effects_.frictions; }

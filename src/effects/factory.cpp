@@ -25,7 +25,6 @@ SceneEffects buildEffects(const Mesh& mesh, const Scene& scene) {
   for (const auto& s : scene.supports) {
     if (s.type != SupportSpec::Type::Foundation) continue;
     auto f = std::make_unique<FoundationEffect>(mesh, s);
-    out.foundations.push_back(f.get());
     out.all.push_back(std::move(f));
   }
 

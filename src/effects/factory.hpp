@@ -24,7 +24,6 @@ struct SceneEffects {
   // order and the residual is summed in it, so it must not change.
   std::vector<std::unique_ptr<Effect>> all;
   BrickEffect* bricks = nullptr;
-  std::vector<FoundationEffect*> foundations;
   std::vector<ContactEffect*> contacts;    // per capstan
   std::vector<FrictionEffect*> frictions;  // per capstan; null without friction
   // The union of all capstans' candidate faces on this rank (4 overlapped node
