@@ -86,11 +86,15 @@ struct FrictionPoint {
 // xn: the face's nodes at the last converged state; lambda, eps, kappa: the
 // normal contact's multipliers and penalties (as in contactFaceResidualTangent);
 // history: Coulomb's traction per point from the last step (3 per point).
+// Kn (if not null, with K): the tangent with respect to xn, dR/dxn (12 x 12),
+// which steady rolling needs: there xn is the upstream nodes' position
+// (src/effects/steady_friction.cpp), an unknown like x.
 // Returns false (R, K untouched) if no point of the face is in contact.
 KOKKOS_INLINE_FUNCTION bool frictionFaceResidualTangent(
     const double X[4][3], const double x[4][3], const double xn[4][3], const Cylinder& cyl,
     double eps, double kappa, const double* lambda, FaceRule rule, const FrictionParameters& fp,
-    const double* history, double R[12], double* K, FrictionPoint pts[kMaxFacePoints]) {
+    const double* history, double R[12], double* K, FrictionPoint pts[kMaxFacePoints],
+    double* Kn = nullptr) {
   const int nq = facePointCount(rule);
   bool touching = false;
   for (int q = 0; q < nq && !touching; ++q) {
@@ -109,6 +113,8 @@ KOKKOS_INLINE_FUNCTION bool frictionFaceResidualTangent(
   for (int k = 0; k < 12; ++k) R[k] = 0;
   if (K)
     for (int k = 0; k < 144; ++k) K[k] = 0;
+  if (K && Kn)
+    for (int k = 0; k < 144; ++k) Kn[k] = 0;
   const double* b = cyl.b;
   for (int q = 0; q < nq; ++q) {
     double xi, eta, w, N[4], dN[4][2];
@@ -156,19 +162,24 @@ KOKKOS_INLINE_FUNCTION bool frictionFaceResidualTangent(
         for (int k = 0; k < 3; ++k) s += ((i == k ? 1.0 : 0.0) - e[i] * e[k]) * D[k][j];
         Dt[i][j] = s - e[i] * duE[j] - en * E[i][j];
       }
+    double P[3][3];  // d(du_t)/dxn = I - e e^T (e depends on x only)
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) P[i][j] = (i == j ? 1.0 : 0.0) - e[i] * e[j];
     const double slip = sqrt(dut[0] * dut[0] + dut[1] * dut[1] + dut[2] * dut[2]);
     p.slip = slip;
-    double t[3], T[3][3];  // traction and dt/dx
+    double t[3], T[3][3], Tn[3][3];  // traction, dt/dx and dt/dxn
     if (fp.law == FrictionLaw::Coulomb) {
       const double* h = history + 3 * q;
       const double eh = e[0] * h[0] + e[1] * h[1] + e[2] * h[2];
       double hE[3];
       for (int j = 0; j < 3; ++j) hE[j] = h[0] * E[0][j] + h[1] * E[1][j] + h[2] * E[2][j];
-      double tr[3], Tr[3][3];  // trial traction and its derivative
+      double tr[3], Tr[3][3], Trn[3][3];  // trial traction and its derivatives
       for (int i = 0; i < 3; ++i) {
         tr[i] = h[i] - eh * e[i] + dut[i] / fp.tangentPenalty;
-        for (int j = 0; j < 3; ++j)
+        for (int j = 0; j < 3; ++j) {
           Tr[i][j] = -e[i] * hE[j] - eh * E[i][j] + Dt[i][j] / fp.tangentPenalty;
+          Trn[i][j] = P[i][j] / fp.tangentPenalty;
+        }
       }
       const double mag = sqrt(tr[0] * tr[0] + tr[1] * tr[1] + tr[2] * tr[2]);
       if (fp.smoothing > 0 && fp.mu > 0 && !fp.stickPredictor) {  // smoothed corner
@@ -176,22 +187,26 @@ KOKKOS_INLINE_FUNCTION bool frictionFaceResidualTangent(
         const double r = sqrt((s - 1) * (s - 1) + fp.smoothing * fp.smoothing);
         const double m = 0.5 * (1 + s + r), dm = 0.5 * (1 + (s - 1) / r);
         p.state = s <= 1 ? 1 : 2;
-        double dS[3];  // ds/dx = (n^T Tr) / (mu t_n) - s / t_n dt_n/dx, dt_n/dx = -(slope/eps) e^T
+        double dS[3], dSn[3];  // ds/dx = (n^T Tr) / (mu t_n) - s / t_n dt_n/dx, dt_n/dx = -(slope/eps) e^T
         for (int j = 0; j < 3; ++j) {
-          double nTr = 0;
+          double nTr = 0, nTrn = 0;
           if (mag > 1e-300)
-            for (int k = 0; k < 3; ++k) nTr += tr[k] / mag * Tr[k][j];
+            for (int k = 0; k < 3; ++k) nTr += tr[k] / mag * Tr[k][j], nTrn += tr[k] / mag * Trn[k][j];
           dS[j] = nTr / (fp.mu * tn) + s / tn * slope * e[j] / eps;
+          dSn[j] = nTrn / (fp.mu * tn);
         }
         for (int i = 0; i < 3; ++i) {
           t[i] = tr[i] / m;
-          for (int j = 0; j < 3; ++j) T[i][j] = Tr[i][j] / m - tr[i] / (m * m) * dm * dS[j];
+          for (int j = 0; j < 3; ++j) {
+            T[i][j] = Tr[i][j] / m - tr[i] / (m * m) * dm * dS[j];
+            Tn[i][j] = Trn[i][j] / m - tr[i] / (m * m) * dm * dSn[j];
+          }
         }
       } else if (mag <= fp.mu * tn || fp.stickPredictor) {  // stick
         p.state = 1;
         for (int i = 0; i < 3; ++i) {
           t[i] = tr[i];
-          for (int j = 0; j < 3; ++j) T[i][j] = Tr[i][j];
+          for (int j = 0; j < 3; ++j) T[i][j] = Tr[i][j], Tn[i][j] = Trn[i][j];
         }
       } else {  // slip: t = mu t_n n, n = tr / |tr|
         p.state = 2;
@@ -200,9 +215,13 @@ KOKKOS_INLINE_FUNCTION bool frictionFaceResidualTangent(
         for (int i = 0; i < 3; ++i) {
           t[i] = fp.mu * tn * n[i];
           for (int j = 0; j < 3; ++j) {
-            double s = 0;
-            for (int k = 0; k < 3; ++k) s += ((i == k ? 1.0 : 0.0) - n[i] * n[k]) * Tr[k][j];
+            double s = 0, sn = 0;
+            for (int k = 0; k < 3; ++k) {
+              s += ((i == k ? 1.0 : 0.0) - n[i] * n[k]) * Tr[k][j];
+              sn += ((i == k ? 1.0 : 0.0) - n[i] * n[k]) * Trn[k][j];
+            }
             T[i][j] = fp.mu * (n[i] * (-slope * e[j] / eps) + tn * s / mag);
+            Tn[i][j] = fp.mu * tn * sn / mag;
           }
         }
       }
@@ -215,9 +234,12 @@ KOKKOS_INLINE_FUNCTION bool frictionFaceResidualTangent(
       for (int j = 0; j < 3; ++j) dutDt[j] = dut[0] * Dt[0][j] + dut[1] * Dt[1][j] + dut[2] * Dt[2][j];
       for (int i = 0; i < 3; ++i) {
         t[i] = fp.mu * tn * psi * dut[i];
-        for (int j = 0; j < 3; ++j)
+        for (int j = 0; j < 3; ++j) {
           T[i][j] = fp.mu * (psi * dut[i] * (-slope * e[j] / eps) + tn * chi * dut[i] * dutDt[j] +
                              tn * psi * Dt[i][j]);
+          // dut^T P = dut^T (dut is tangent)
+          Tn[i][j] = fp.mu * tn * (chi * dut[i] * dut[j] + psi * P[i][j]);
+        }
       }
     }
     for (int i = 0; i < 3; ++i) p.traction[i] = t[i];
@@ -239,7 +261,10 @@ KOKKOS_INLINE_FUNCTION bool frictionFaceResidualTangent(
       for (int c = 0; c < 4; ++c) {
         const double s = p.weight * N[a] * N[c];
         for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j) K[(3 * a + i) * 12 + 3 * c + j] -= s * T[i][j];
+          for (int j = 0; j < 3; ++j) {
+            K[(3 * a + i) * 12 + 3 * c + j] -= s * T[i][j];
+            if (Kn) Kn[(3 * a + i) * 12 + 3 * c + j] -= s * Tn[i][j];
+          }
       }
   }
   return true;

@@ -13,6 +13,10 @@ namespace capstan {
 Assembly::Assembly(const Mesh& mesh, const Scene& scene)
     : mesh_(mesh), effects_(buildEffects(mesh, scene)), cores_(mesh, scene), constraints_(mesh, scene, cores_),
       layout_(cores_.layout()) {
+  for (const auto& effect : effects_.all) effect->bindCores(cores_);
+  // Steady friction couples a contact node to the nodes one ring cell upstream
+  // and to omega, outside the bricks' 27-node stencil.
+  extraColumns_ = scene.analysis.steady() ? 24 : 0;
   buildDofMaps();
   importer_ = rcp(new Tpetra::Import<>(ownedDofMap_, overlapDofMap_));
   buildGraph();
@@ -34,13 +38,13 @@ void Assembly::buildGraph() {
   auto gid = [&](int dof) { return overlap.getGlobalElement(layout_.overlapLid(dof)); };
   cores_.findCoupling(effects_.all);
   if (cores_.empty()) {
-    graph_ = rcp(new FEGraph(ownedDofMap_, overlapDofMap_, 81, importer_));
+    graph_ = rcp(new FEGraph(ownedDofMap_, overlapDofMap_, 81 + extraColumns_, importer_));
   } else {
     // A node's row has at most 81 entries (27 nodes), plus a core's 4 unknowns;
     // a core's rows have one entry per dof of the elements at its face.
     Kokkos::DualView<size_t*, FEGraph::device_type> perRow("entries per row", overlap.getNodeNumElements());
     auto h = perRow.view_host();
-    Kokkos::deep_copy(h, size_t(81 + 4 * cores_.size()));
+    Kokkos::deep_copy(h, size_t(81 + extraColumns_ + 4 * cores_.size()));
     for (size_t c = 0; c < cores_.size(); ++c)
       for (int j = 0; j < 6; ++j) h(layout_.overlapLid(cores_.records()[c].firstDof + j)) = cores_.rowEntries(c);
     perRow.modify_host();
@@ -51,12 +55,16 @@ void Assembly::buildGraph() {
   for (const auto& effect : effects_.all) {
     if (!effect->local().stiff) continue;  // no stiffness, no graph entries
     auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), effect->local().dofs);
+    const size_t rows = effect->local().rowDofs > 0 ? size_t(effect->local().rowDofs) : dofs.extent(1);
     std::vector<GO> cols;
     for (size_t e = 0; e < dofs.extent(0); ++e) {
       cols.clear();
       for (size_t k = 0; k < dofs.extent(1); ++k) cols.push_back(gid(dofs(e, k)));
       cores_.appendFreeUnknowns(&dofs(e, 0), dofs.extent(1), gid, cols);
-      for (GO row : cols) graph_->insertGlobalIndices(row, Teuchos::ArrayView<const GO>(cols));
+      for (size_t k = 0; k < rows; ++k) graph_->insertGlobalIndices(cols[k], Teuchos::ArrayView<const GO>(cols));
+      // A core's unknowns appended above get rows too (the chain rule's).
+      for (size_t k = dofs.extent(1); k < cols.size(); ++k)
+        graph_->insertGlobalIndices(cols[k], Teuchos::ArrayView<const GO>(cols));
     }
   }
   if (layout_.coresOwned)  // the cores' held dofs get their unit diagonal
@@ -106,6 +114,7 @@ void Assembly::buildTangentSinks() {
     TangentSink& sink = sinks_.back();
     auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.dofs);
     const size_t ne = dofs.extent(0), n = dofs.extent(1), nb = n / 3;
+    const size_t rows = L.rowDofs > 0 ? size_t(L.rowDofs) : n;
     if (n > 30) throw std::logic_error("assembly: an entity has more than 30 dofs (the held-column mask is an int)");
     sink.rowBlock = decltype(sink.rowBlock)("tangent row blocks", ne, n * nb);
     sink.heldColumns = Kokkos::View<int*>("tangent held columns", ne);
@@ -120,7 +129,7 @@ void Assembly::buildTangentSinks() {
         for (size_t b = 0; b < nb; ++b) {
           int& o = hb(e, k * nb + b);
           o = -1;
-          if (supportOf[dofs(e, k)] >= 0) continue;  // a held row: the identity
+          if (supportOf[dofs(e, k)] >= 0 || k >= rows) continue;  // a held row (the identity), or no row
           // A node's 3 columns sit side by side in every row (its dofs have
           // consecutive column ids, and each row's entries are sorted).
           for (size_t j = 0; j < 3; ++j) {

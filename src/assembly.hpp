@@ -34,6 +34,7 @@ class Assembly {
   // Whether the dof with this local id in dofMap() is held (a constrained row).
   bool ownedConstrained(LO d) const { return constraints_.held(layout_.assemblyDof(d)); }
   const std::vector<RigidCore>& rigidCores() const { return cores_.records(); }
+  RigidCores& cores() { return cores_; }
   // Local id in dofMap() of a rigid core's dof j (0..5) on rank 0, -1 elsewhere.
   LO ownedCoreDof(size_t core, int j) const {
     return layout_.coresOwned ? LO(3 * mesh_.numOwnedNodes + 6 * core + j) : -1;
@@ -121,6 +122,7 @@ class Assembly {
   RigidCores cores_;
   Constraints constraints_;
   DofLayout layout_;         // the cores' (RigidCores::layout)
+  size_t extraColumns_ = 0;  // per row beyond the bricks' 81 (steady friction)
   RCP<const Map> ownedDofMap_, overlapDofMap_;
   std::vector<LO> columnOf_;            // per assembly dof: local column of the matrix, or -1
   double time_ = 0;

@@ -11,6 +11,7 @@ Constraints::Constraints(const Mesh& mesh, const Scene& scene, RigidCores& cores
   const size_t ndof = size_t(layout_.size());
   supportOf.assign(ndof, -1);
   velocity.assign(ndof, 0.0);
+  constant.assign(ndof, 0);
   for (const auto& s : scene.supports) {
     if (s.type == SupportSpec::Type::Foundation) continue;  // an effect (src/effects/factory.hpp), no held dofs
     const int id = int(supportNames.size());
@@ -26,6 +27,7 @@ Constraints::Constraints(const Mesh& mesh, const Scene& scene, RigidCores& cores
         if (j < 4 && core.free[j]) continue;  // an unknown of the Newton solve
         supportOf[core.firstDof + j] = id;
         velocity[core.firstDof + j] = j == 3 && s.rotation == SupportSpec::Rotation::Prescribed ? s.angularVelocity : 0.0;
+        constant[core.firstDof + j] = j == 3 && scene.analysis.steady();
       }
       continue;
     }
@@ -44,7 +46,7 @@ void Constraints::apply(Vector& u, double t, const RigidCores& cores) const {
   auto data = u.getDataNonConst();
   for (LO d = 0; d < LO(data.size()); ++d) {
     const int a = layout_.assemblyDof(d);
-    if (supportOf[a] >= 0 && !cores.follows(a)) data[d] = velocity[a] * t;
+    if (supportOf[a] >= 0 && !cores.follows(a)) data[d] = constant[a] ? velocity[a] : velocity[a] * t;
   }
 }
 
@@ -57,10 +59,11 @@ void Constraints::increment(Vector& z, double t0, double t1, const RigidCores& c
       const auto& core = cores.records()[cores.coreOf(a / 3)];
       const int i = a % 3;
       const double dT = supportOf[core.firstDof + i] >= 0 ? velocity[core.firstDof + i] * (t1 - t0) : 0.0;
-      const double dTheta = supportOf[core.firstDof + 3] >= 0 ? velocity[core.firstDof + 3] * (t1 - t0) : 0.0;
+      const int r = core.firstDof + 3;
+      const double dTheta = supportOf[r] >= 0 && !constant[r] ? velocity[r] * (t1 - t0) : 0.0;
       data[d] = dT + cores.follower(a / 3).b[i] * dTheta;
     } else {
-      data[d] = supportOf[a] >= 0 ? velocity[a] * (t1 - t0) : 0.0;
+      data[d] = supportOf[a] >= 0 && !constant[a] ? velocity[a] * (t1 - t0) : 0.0;
     }
   }
 }

@@ -29,6 +29,9 @@ class Constraints {
   std::vector<std::string> supportNames;  // index = support id
   std::vector<int> supportOf;             // per assembly dof: support id or -1
   std::vector<double> velocity;           // per assembly dof
+  // Per assembly dof: held at `velocity` itself, not velocity * t (steady
+  // rolling's prescribed angular velocity: the core's unknown is omega there).
+  std::vector<char> constant;
 
   bool held(int dof) const { return supportOf[dof] >= 0; }
   // Sets u's held entries (owned values) to their values at time t, except a

@@ -11,10 +11,12 @@ constexpr double kMinimumSubstep = 1.0 / 1024;
 }  // namespace
 
 LoadStepper::LoadStepper(Model& model, Log& log, bool checkTangent, double tDone)
-    : m_(model), log_(log), predictors_(model, log), augmentation_(model, log, checkTangent), tDone_(tDone) {}
+    : m_(model), log_(log), predictors_(model, log), augmentation_(model, log, checkTangent),
+      steady_(model, log, augmentation_, tDone > 0), tDone_(tDone) {}
 
 bool LoadStepper::solveIncrement(double t0, double t1, StepRecord& rec, std::string& failure) {
   m_.assembly->setInterval(t0, t1);
+  if (m_.scene.analysis.steady()) return steady_.solve(t1, rec, failure);
   const double bare = predictors_.firstGuess(t0, t1, rec);
   return augmentation_.solve(t1, bare, rec, failure);
 }

@@ -10,6 +10,7 @@
 #include "log.hpp"
 #include "model.hpp"
 #include "predictors.hpp"
+#include "steady_rolling.hpp"
 #include "step_record.hpp"
 
 namespace capstan {
@@ -32,6 +33,7 @@ class LoadStepper {
   Log& log_;
   Predictors predictors_;
   AugmentationLoop augmentation_;
+  SteadyRolling steady_;  // Analysis/Type = Steady Rolling: each step a steady state
   double tDone_;
 };
 

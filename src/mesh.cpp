@@ -7,6 +7,7 @@
 #include <Tpetra_Map.hpp>
 
 #include <algorithm>
+#include <set>
 #include <cmath>
 #include <numeric>
 #include <stdexcept>
@@ -155,6 +156,12 @@ std::vector<GO> AnnulusGenerator::faceNeighbours(GO e) const {
   return nb;
 }
 
+GO AnnulusGenerator::ringNeighbour(GO n, int step) const {
+  const GO sr = n_[0] + 1;
+  const GO i = n % sr, j = (n / sr) % n_[1], k = n / (sr * n_[1]);
+  return node(i, j + n_[1] + step, k);
+}
+
 // ---------------------------------------------------------------- distribution
 
 namespace {
@@ -260,7 +267,8 @@ Partition partitionFor(const std::string& name, int slowestCells, int ranks) {
 
 const char* partitionName(Partition partition) { return partition == Partition::Slabs ? "Slabs" : "METIS"; }
 
-Mesh distributeMesh(const MeshGenerator& gen, const RCP<const Comm>& comm, Partition partition) {
+Mesh distributeMesh(const MeshGenerator& gen, const RCP<const Comm>& comm, Partition partition,
+                    const std::vector<std::string>& streamlineFaces) {
   Mesh m;
   m.comm = comm;
   m.partition = partition;
@@ -285,6 +293,24 @@ Mesh distributeMesh(const MeshGenerator& gen, const RCP<const Comm>& comm, Parti
   m.numOwnedNodes = m.nodeGids.size();
   for (GO n : touched)
     if (!m.ownedNodeMap->isNodeGlobalElement(n)) m.nodeGids.push_back(n);
+  // Ring neighbours of the streamline faces' nodes: ghosts too (owned by the
+  // ranks whose elements hold them).
+  std::vector<std::pair<GO, std::array<GO, 4>>> rings;
+  if (!streamlineFaces.empty()) {
+    std::set<GO> seen(touched.begin(), touched.end()), extra;
+    for (GO e : m.elementGids)
+      for (const auto& f : gen.boundaryFaces(e)) {
+        if (std::find(streamlineFaces.begin(), streamlineFaces.end(), f.name) == streamlineFaces.end()) continue;
+        for (GO n : f.nodes) {
+          std::array<GO, 4> nb;
+          for (int s = 0; s < 4; ++s) nb[s] = gen.ringNeighbour(n, Mesh::kRingSteps[s]);
+          rings.push_back({n, nb});
+          for (GO x : nb)
+            if (x >= 0 && !seen.count(x)) extra.insert(x);
+        }
+      }
+    m.nodeGids.insert(m.nodeGids.end(), extra.begin(), extra.end());
+  }
   m.overlapNodeMap = rcp(new Map(invalid, Teuchos::ArrayView<const GO>(m.nodeGids), 0, comm));
   m.ownedDofMap = dofMap(std::vector<GO>(owned.begin(), owned.end()), comm);
   m.overlapDofMap = dofMap(m.nodeGids, comm);
@@ -296,6 +322,9 @@ Mesh distributeMesh(const MeshGenerator& gen, const RCP<const Comm>& comm, Parti
     const auto X = gen.nodeCoordinates(m.nodeGids[n]);
     for (int d = 0; d < 3; ++d) m.X[3 * n + d] = X[d];
   }
+  m.ringNeighbours.assign(m.nodeGids.size(), {-1, -1, -1, -1});
+  for (const auto& [n, nb] : rings)
+    for (int s = 0; s < 4; ++s) m.ringNeighbours[lid.at(n)][s] = nb[s] >= 0 ? lid.at(nb[s]) : -1;
   for (const auto& name : m.faceNames) m.faces[name];
   for (GO e : m.elementGids) {
     for (GO n : gen.elementNodes(e)) m.connectivity.push_back(lid.at(n));

@@ -32,6 +32,10 @@ class MeshGenerator {
   virtual std::vector<BoundaryFace> boundaryFaces(GO element) const = 0;
   // Elements sharing a face with `element` (the dual graph).
   virtual std::vector<GO> faceNeighbours(GO element) const = 0;
+  // The node next to `node` on its ring about the mesh's axis, one cell on
+  // (step +1) or back (-1), or -1 where the mesh has no rings (steady rolling's
+  // streamlines, formulation.md §8).
+  virtual GO ringNeighbour(GO /*node*/, int /*step*/) const { return -1; }
 };
 
 // How elements are split over the ranks.
@@ -98,6 +102,7 @@ class AnnulusGenerator : public MeshGenerator {
   std::array<double, 3> nodeCoordinates(GO node) const override;
   std::vector<BoundaryFace> boundaryFaces(GO element) const override;
   std::vector<GO> faceNeighbours(GO element) const override;
+  GO ringNeighbour(GO node, int step) const override;
 
  private:
   std::array<double, 3> center_;
@@ -123,6 +128,12 @@ struct Mesh {
   Partition partition = Partition::Metis;  // how the elements were split
   std::vector<int> connectivity;     // 8 overlapped node ids per element
   std::map<std::string, std::vector<int>> faces;  // 4 overlapped node ids per quad
+  // Per overlapped node on a streamline face (distributeMesh): its ring
+  // neighbours two and one cells back, one and two cells on (overlapped ids;
+  // kRingSteps), else -1. Those neighbours are ghosts of this rank even where
+  // none of its elements holds them.
+  static constexpr int kRingSteps[4] = {-2, -1, 1, 2};
+  std::vector<std::array<int, 4>> ringNeighbours;
 
   RCP<const Map> ownedNodeMap, overlapNodeMap, ownedDofMap, overlapDofMap;
 
@@ -133,7 +144,8 @@ struct Mesh {
 };
 
 // Partitions the generator's elements over comm and builds this rank's part.
+// streamlineFaces: faces whose nodes need their ring neighbours (steady rolling).
 Mesh distributeMesh(const MeshGenerator& generator, const RCP<const Comm>& comm,
-                    Partition partition = Partition::Metis);
+                    Partition partition = Partition::Metis, const std::vector<std::string>& streamlineFaces = {});
 
 }  // namespace capstan

@@ -26,7 +26,12 @@ Model::Model(const Scene& scene_, const RCP<const Comm>& comm_)
                                                    m.outerCellRatio, m.fineSector);
   else
     generator = std::make_unique<BoxGenerator>(m.min, m.max, m.cells);
-  mesh = distributeMesh(*generator, comm, partitionFor(m.partition, m.cells[2], comm->getSize()));
+  // Steady rolling differences friction along the rings of the contact faces.
+  std::vector<std::string> streamlineFaces;
+  if (scene.analysis.steady())
+    for (const auto& c : scene.capstans)
+      if (c.friction.on()) streamlineFaces.insert(streamlineFaces.end(), c.contactFaces.begin(), c.contactFaces.end());
+  mesh = distributeMesh(*generator, comm, partitionFor(m.partition, m.cells[2], comm->getSize()), streamlineFaces);
   assembly = std::make_unique<Assembly>(mesh, scene);
   try {
     const bool friction = std::any_of(scene.capstans.begin(), scene.capstans.end(),

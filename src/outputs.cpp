@@ -192,6 +192,17 @@ void Outputs::writeFields(int step, double time) {
   outputSeconds_ += since(t);
 }
 
+void Outputs::openNip(int lastKept) {
+  nip_ = std::make_unique<NipTable>(m_, dir_ / "nip.csv");
+  nip_->open(lastKept);
+}
+
+void Outputs::writeNip(int step) {
+  const auto t = Clock::now();
+  nip_->add(step);
+  outputSeconds_ += since(t);
+}
+
 void Outputs::writeHistory(const std::vector<StepRecord>& steps) {
   if (!m_.rank0) return;
   // The columns: those of the run's records, or of an empty record with the
@@ -272,7 +283,7 @@ void Outputs::writeSummary(const std::vector<StepRecord>& steps, bool converged,
   top.add("title", json::string(m_.scene.title)).add("scene", json::string(m_.scene.file))
       .add("version", json::string(CAPSTAN_VERSION))
       .add("ranks", json::number(m_.comm->getSize()))
-      .add("analysis", json::string("Quasi-Static"))  // interface.md, "Steady rolling"
+      .add("analysis", json::string(m_.scene.analysis.name()))  // interface.md, "Steady rolling"
       .add("converged", converged ? "true" : "false")
       .add("failure", converged ? "null" : json::string(failure))
       .add("mesh", meshObject.str()).add("steps", stepList).add("final", fin.str())

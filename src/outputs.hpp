@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "field_writer.hpp"
+#include "nip_table.hpp"
 #include "log.hpp"
 #include "model.hpp"
 #include "step_record.hpp"
@@ -44,6 +45,10 @@ class Outputs {
   // The step's fields (collective).
   void writeFields(int step, double time);
   void writeHistory(const std::vector<StepRecord>& steps);
+  // nip.csv: started (a restart keeps the earlier run's rows up to lastKept),
+  // then each converged step's rows (collective).
+  void openNip(int lastKept);
+  void writeNip(int step);
   void writeSummary(const std::vector<StepRecord>& steps, bool converged, const std::string& failure);
   // This run's timings plus the earlier runs' (`earlier`, from a checkpoint).
   Timings timings() const;
@@ -59,6 +64,7 @@ class Outputs {
   std::chrono::steady_clock::time_point t0_;
   std::filesystem::path dir_;
   std::unique_ptr<FieldWriter> writer_;
+  std::unique_ptr<NipTable> nip_;
   double outputSeconds_ = 0;
 };
 

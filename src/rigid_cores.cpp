@@ -9,7 +9,7 @@
 
 namespace capstan {
 
-RigidCores::RigidCores(const Mesh& mesh, const Scene& scene) : mesh_(mesh) {
+RigidCores::RigidCores(const Mesh& mesh, const Scene& scene) : mesh_(mesh), steady_(scene.analysis.steady()) {
   const int nodeDofs = int(3 * mesh.numOverlapNodes());
   // Rigid cores first: their face nodes follow the core whatever other
   // support also names them.
@@ -38,7 +38,9 @@ int RigidCores::find(const std::string& name) const {
 void RigidCores::read(const Teuchos::ArrayRCP<const double>& ud) {
   for (auto& core : cores_) {
     for (int i = 0; i < 3; ++i) core.translation[i] = ud[layout_.overlapLid(core.firstDof + i)];
-    core.rotation = ud[layout_.overlapLid(core.firstDof + 3)];
+    const double q3 = ud[layout_.overlapLid(core.firstDof + 3)];
+    core.rotation = steady_ ? 0.0 : q3;
+    core.angularVelocity = steady_ ? q3 : core.angularVelocity;
   }
   followers_.resize(mesh_.numOverlapNodes());
   for (size_t n = 0; n < coreOfNode_.size(); ++n) {
@@ -95,7 +97,7 @@ void RigidCores::setReactions(const double* ownedResidual) {
   for (size_t c = 0; c < cores_.size(); ++c) {
     for (int i = 0; i < 3; ++i) cores_[c].forceOnBody[i] = s[c][i];
     cores_[c].torqueOnBody = s[c][3];
-    cores_[c].geometric = s[c][4];
+    cores_[c].geometric = steady_ ? 0.0 : s[c][4];  // steady: b does not change with omega
   }
 }
 
@@ -110,7 +112,7 @@ void RigidCores::findCoupling(const std::vector<std::unique_ptr<Effect>>& effect
     for (size_t e = 0; e < dofs.extent(0); ++e) {
       bool touches = false;
       for (size_t k = 0; k < dofs.extent(1); ++k) {
-        const int c = coreOfNode_[dofs(e, k) / 3];
+        const int c = dofs(e, k) < layout_.nodeDofs ? coreOfNode_[dofs(e, k) / 3] : -1;
         if (c < 0) continue;
         touches = true;
         for (size_t l = 0; l < dofs.extent(1); ++l) seen[c][dofs(e, l)] = 1;
@@ -148,15 +150,15 @@ void RigidCores::assembleCoupling(FEMatrix& W, const std::vector<std::unique_ptr
     const auto K = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sinks[i].kept);
     const auto active = activeOnHost(L);
     const int n = int(dofs.extent(1));
-    std::vector<std::array<double, 4>> B(n);
+    std::vector<std::array<double, 4>> B(n), C(n);  // row and column chains
     std::vector<int> coreOf(n);
     for (size_t slot = 0; slot < coupled_[i].size(); ++slot) {
       const int e = coupled_[i][slot];
       if (active.size() && !active(e)) continue;
       for (int k = 0; k < n; ++k) {
-        const int d = dofs(e, k), c = coreOfNode_[d / 3];
+        const int d = dofs(e, k), c = d < layout_.nodeDofs ? coreOfNode_[d / 3] : -1;
         coreOf[k] = c;
-        if (c >= 0) B[k] = chain(d);
+        if (c >= 0) B[k] = chain(d), C[k] = chainColumn(d);
       }
       for (int k = 0; k < n; ++k)
         for (int l = 0; l < n; ++l) {
@@ -166,14 +168,14 @@ void RigidCores::assembleCoupling(FEMatrix& W, const std::vector<std::unique_ptr
           if (ck < 0) {
             if (supportOf[dk] >= 0) continue;
             touched[dk] = 1;
-            for (int j = 0; j < 4; ++j) toCore[(4 * cl + j) * nodeDofs + dk] += Kkl * B[l][j];
+            for (int j = 0; j < 4; ++j) toCore[(4 * cl + j) * nodeDofs + dk] += Kkl * C[l][j];
           } else if (cl < 0) {
             if (supportOf[dl] >= 0) continue;
             touched[dl] = 1;
             for (int j = 0; j < 4; ++j) fromCore[(4 * ck + j) * nodeDofs + dl] += B[k][j] * Kkl;
           } else {
             for (int a = 0; a < 4; ++a)
-              for (int b = 0; b < 4; ++b) coreCore[(4 * ck + a) * nq + 4 * cl + b] += B[k][a] * Kkl * B[l][b];
+              for (int b = 0; b < 4; ++b) coreCore[(4 * ck + a) * nq + 4 * cl + b] += B[k][a] * Kkl * C[l][b];
           }
         }
     }
@@ -197,6 +199,10 @@ void RigidCores::assembleCoupling(FEMatrix& W, const std::vector<std::unique_ptr
   for (size_t q = 0; q < nq; ++q) {
     if (!freeCoreDof(q)) continue;
     cols.clear(), vals.clear();
+    if (q % 4 == 3 && cores_[q / 4].holding()) {  // steady rolling's start: omega - held = 0
+      if (layout_.coresOwned) cols.push_back(columnOf[coreDof(q)]), vals.push_back(1.0), add(layout_.overlapLid(coreDof(q)));
+      continue;
+    }
     for (int d = 0; d < nodeDofs; ++d)
       if (touched[d] && fromCore[q * nodeDofs + d] != 0)
         cols.push_back(columnOf[d]), vals.push_back(fromCore[q * nodeDofs + d]);

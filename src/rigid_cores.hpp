@@ -8,6 +8,8 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
+#include <limits>
 #include <memory>
 #include <set>
 #include <string>
@@ -25,6 +27,9 @@ class Constraints;
 // A rigid core (SupportSpec type Rigid Core) as the assembly keeps it: its
 // unknowns q = (T, theta) are global dofs owned by rank 0; its face's nodes
 // are eliminated (u = T + (R(theta) - I)(X - A), kernels/rigid_core.hpp).
+// In steady rolling (formulation.md §8) the mesh does not turn: the fourth
+// unknown is the angular velocity omega, the face nodes sit at X + T, and
+// omega's equation is still the torque balance (the reactions' moment).
 struct RigidCore {
   std::string name;
   std::array<double, 3> axisPoint{}, axisDirection{}, force{};
@@ -36,6 +41,11 @@ struct RigidCore {
   // on the body (the reactions at its face's nodes).
   std::array<double, 3> translation{};
   double rotation = 0;
+  double angularVelocity = 0;  // steady rolling: the fourth unknown
+  // Steady rolling's start (LoadStepper): omega held at this value by its own
+  // row (omega - heldAngularVelocity = 0) while free, where NaN: not held.
+  double heldAngularVelocity = std::numeric_limits<double>::quiet_NaN();
+  bool holding() const { return !std::isnan(heldAngularVelocity); }
   std::array<double, 3> forceOnBody{};
   double torqueOnBody = 0;
   double geometric = 0;  // sum over the face's nodes of R . w (the theta-theta tangent term)
@@ -64,12 +74,22 @@ class RigidCores {
   bool follows(int dof) const { return dof < layout_.nodeDofs && coreOfNode_[dof / 3] >= 0; }
   // A face node's displacement and derivatives at the cores' last q (read()).
   const kernels::CoreFollower& follower(size_t node) const { return followers_[node]; }
-  // d u_dof / d (Tx, Ty, Tz, theta) of the core that a face-node dof follows
-  // (at the cores' last q): the chain rule's coefficients.
+  // The chain rule's coefficients for a face-node dof: rows (the moment of
+  // the reactions: the torque balance) take b; columns take d u_dof / d q,
+  // (Tx, Ty, Tz, theta) of the core it follows at the cores' last q, which
+  // in steady rolling has no omega part (the face nodes sit at X + T).
   std::array<double, 4> chain(int dof) const {
     const int i = dof % 3;
     return {i == 0 ? 1.0 : 0.0, i == 1 ? 1.0 : 0.0, i == 2 ? 1.0 : 0.0, followers_[dof / 3].b[i]};
   }
+  std::array<double, 4> chainColumn(int dof) const {
+    auto B = chain(dof);
+    if (steady_) B[3] = 0;
+    return B;
+  }
+  bool steady() const { return steady_; }
+  // Steady rolling's start: hold core c's free omega at `value` (NaN: free again).
+  void holdAngularVelocity(size_t c, double value) { cores_[c].heldAngularVelocity = value; }
 
   // The cores' q from the overlapped u, and each face node's follower data.
   void read(const Teuchos::ArrayRCP<const double>& uOverlap);
@@ -89,6 +109,7 @@ class RigidCores {
   double residual(int dof, double t) const {
     const auto& core = cores_[(dof - layout_.nodeDofs) / 6];
     const int j = (dof - layout_.nodeDofs) % 6;
+    if (j == 3 && core.holding()) return core.angularVelocity - core.heldAngularVelocity;
     return j < 3 ? core.forceOnBody[j] - core.loadFactor(t) * core.force[j]
                  : core.torqueOnBody - core.torqueFactor(t) * core.torque;
   }
@@ -107,7 +128,7 @@ class RigidCores {
     if (cores_.empty()) return;
     std::set<int> touched;
     for (size_t k = 0; k < n; ++k)
-      if (coreOfNode_[dofs[k] / 3] >= 0) touched.insert(coreOfNode_[dofs[k] / 3]);
+      if (dofs[k] < layout_.nodeDofs && coreOfNode_[dofs[k] / 3] >= 0) touched.insert(coreOfNode_[dofs[k] / 3]);
     for (int c : touched)
       for (int j = 0; j < 4; ++j)
         if (cores_[c].free[j]) cols.push_back(gid(cores_[c].firstDof + j));
@@ -118,7 +139,7 @@ class RigidCores {
   template <class F>
   void forEachFreeUnknown(int dof, const F& f) const {
     const RigidCore& core = cores_[coreOfNode_[dof / 3]];
-    const auto B = chain(dof);
+    const auto B = chainColumn(dof);
     for (int q = 0; q < 4; ++q)
       if (core.free[q] && (q == 3 || q == dof % 3)) f(core.firstDof + q, B[q]);
   }
@@ -132,6 +153,7 @@ class RigidCores {
 
  private:
   const Mesh& mesh_;
+  bool steady_ = false;  // Analysis/Type = Steady Rolling
   DofLayout layout_;
   std::vector<RigidCore> cores_;
   std::vector<int> coreOfNode_;                   // per overlapped node: its rigid core or -1

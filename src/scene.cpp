@@ -49,6 +49,8 @@ ParameterList validParameters() {
         "Fine (four times). Solver parameters the scene sets itself win. Measured errors and "
         "costs on G1 and H1: docs/accuracy.md");
 
+  AnalysisSettings::declare(p.sublist("Analysis", false, "What each step solves"));
+
   auto& mesh = p.sublist("Mesh", false, "The rubber body's mesh");
   mesh.set("Type", std::string("Box"),
            "Box (structured brick mesh; faces xmin xmax ymin ymax zmin zmax) | Annulus (hollow "
@@ -620,6 +622,7 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
   sc.resolved = *user;
   const auto& P = sc.resolved;
   sc.title = P.get<std::string>("Title");
+  sc.analysis = AnalysisSettings::parse(P.sublist("Analysis"), v);
 
   const auto& mesh = P.sublist("Mesh");
   sc.mesh.type = v.choice(mesh, "Mesh", "Type", MeshSpec::types);
@@ -710,6 +713,7 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
   if (sc.steps < 1) v.fail("Time/Steps", "must be >= 1, got " + std::to_string(sc.steps));
   sc.stepSize = v.positive(time, "Time", "Step Size");
   rejectSingularCores(sc, v);
+  AnalysisSettings::checkScene(sc, v);
   for (auto& s : sc.supports)
     if (s.isCore() && s.rampTime == 0) s.rampTime = sc.stepSize;
   for (auto& s : sc.supports)

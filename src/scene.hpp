@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "analysis_settings.hpp"
 #include "effects/contact_settings.hpp"
 #include "effects/friction_settings.hpp"
 #include "solver_settings.hpp"
@@ -44,6 +45,7 @@ struct CapstanSpec {
 
 struct Scene {
   std::string file, title;
+  AnalysisSettings analysis;       // Quasi-Static or Steady Rolling
   MeshSpec mesh;
   double c = 1, pressurePenalty = 1e-3;
   std::array<double, 3> bodyForce{};  // Loads/Body Force at the end of the run

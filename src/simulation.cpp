@@ -64,6 +64,7 @@ class Simulation {
                            restart_->step(), restart_->time()));
     }
     outputs_->openFields(options_.restart, restart_ ? restart_->step() : -1);
+    outputs_->openNip(restart_ ? restart_->step() : -1);
     const double t = restart_ ? restart_->time() : 0.0;
     model_->assembly->setInterval(t, t);
     model_->assembly->evaluate(*model_->u, nullptr, nullptr);
@@ -77,6 +78,7 @@ class Simulation {
     rec.wall = since(stepStart);
     steps_.push_back(rec);
     outputs_->writeFields(rec.step, rec.time);
+    outputs_->writeNip(rec.step);
     for (const auto& e : model_->effects()) e->commit(model_->assembly->positions());
     outputs_->writeHistory(steps_);
     if (scene_.checkpointEvery > 0 && rec.step % scene_.checkpointEvery == 0)

@@ -61,7 +61,9 @@ void measureStep(const Model& model, const std::vector<StepRecord>& earlier, Ste
       for (const auto& p : earlier.back().supports)
         if (p.name == core.name) before = p.rotation;
     }
-    sr.angularVelocity = (core.rotation - before) / (rec.time - tBefore);
+    // Steady rolling: the angular velocity is the core's unknown itself.
+    sr.angularVelocity = model.scene.analysis.steady() ? core.angularVelocity
+                                                       : (core.rotation - before) / (rec.time - tBefore);
     const double rolling = noSlipAngularVelocity(model.scene, core);
     sr.hasSpeedRatio = rolling != 0;
     if (sr.hasSpeedRatio) sr.speedRatio = sr.angularVelocity / rolling;

@@ -78,10 +78,10 @@ TEST_P(FrictionTangent, MatchesCentralDifferences) {
     face(X, -0.1, 5 + pos);
     face(xn, 0.058 + 0.004 * pos, 50 + pos);  // last converged state
     face(x, 0.060 + 0.004 * pos, 500 + pos);  // now: moved a little since then
-    std::vector<double> R(12), K(144);
+    std::vector<double> R(12), K(144), Kn(144);
     FrictionPoint pts[kMaxFacePoints];
     ASSERT_TRUE(frictionFaceResidualTangent(X, x, xn, cyl, 1e-2, 1e-2, lambda, FaceRule::Gauss2, fp, h,
-                                            R.data(), K.data(), pts))
+                                            R.data(), K.data(), pts, Kn.data()))
         << k.name << ": face not in contact at position " << pos;
     bool nearSwitch = false;
     for (int q = 0; q < 4; ++q) {
@@ -113,6 +113,22 @@ TEST_P(FrictionTangent, MatchesCentralDifferences) {
       }
     }
     EXPECT_LT(maxErr / scale, 1e-6) << k.name << " position " << pos;
+    // dR/dxn (steady rolling: xn is the upstream nodes' position, an unknown).
+    double maxErrN = 0, scaleN = 0;
+    for (int col = 0; col < 12; ++col) {
+      xn[col / 3][col % 3] += hx;
+      const auto Rp = residual(X, x, xn, cyl, fp, lambda, h);
+      xn[col / 3][col % 3] -= 2 * hx;
+      const auto Rm = residual(X, x, xn, cyl, fp, lambda, h);
+      xn[col / 3][col % 3] += hx;
+      for (int row = 0; row < 12; ++row) {
+        const double fd = (Rp[row] - Rm[row]) / (2 * hx);
+        maxErrN = std::max(maxErrN, std::fabs(Kn[row * 12 + col] - fd));
+        scaleN = std::max(scaleN, std::fabs(fd));
+      }
+    }
+    EXPECT_GT(scaleN, 0) << k.name;
+    EXPECT_LT(maxErrN / scaleN, 1e-6) << k.name << " position " << pos << " (dR/dxn)";
     ++checked;
   }
   EXPECT_GE(checked, 4) << k.name;

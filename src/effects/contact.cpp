@@ -16,9 +16,6 @@ namespace capstan {
 using detail::dofsOf;
 using detail::loadEntities;
 
-namespace {
-enum PointField { kGap = 0, kPressure, kWeight, kArea, kE, kX = kE + 3 };
-}
 
 static_assert(int(ContactSettings::Quadrature::Gauss2x2) == int(kernels::FaceRule::Gauss2) &&
                   int(ContactSettings::Quadrature::Gauss3x3) == int(kernels::FaceRule::Gauss3) &&

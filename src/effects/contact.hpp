@@ -74,6 +74,10 @@ class ContactEffect : public Effect {
   const CapstanSpec& capstan() const { return capstan_; }
   const ContactSettings& settings() const { return capstan_.contact; }
   size_t numFaces() const { return nodes_.extent(0); }
+  // Per face and point at the last evaluation (host copy), fields PointField.
+  enum PointField { kGap = 0, kPressure, kWeight, kArea, kE, kX = kE + 3 };
+  using Points = Kokkos::View<double** [10], Kokkos::LayoutRight>;
+  Points::HostMirror pointsOnHost() const { return Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), points_); }
 
  protected:
   void launch(const NodalVectors& x, const NodalVectors& u, bool tangent, const TangentSink& sink) override;
@@ -83,7 +87,7 @@ class ContactEffect : public Effect {
   Kokkos::View<double* [4][3], Kokkos::LayoutRight> X_;
   Kokkos::View<double*> lambda_;  // [face * kMaxFacePoints + q]
   // Per face and point at the last evaluation: gap, pressure, weight, area, e (3), x (3).
-  Kokkos::View<double** [10], Kokkos::LayoutRight> points_;
+  Points points_;
   CapstanSpec capstan_;
   double tolerance_ = 0;          // on eps |t_n - lambda| (length), resolved against the mesh
   std::array<double, 3> beta_{};  // unit axis direction

@@ -17,6 +17,7 @@
 namespace capstan {
 
 struct Mesh;
+class RigidCores;
 
 using ExecSpace = Kokkos::DefaultExecutionSpace;
 // Row-major per entity, so a kernel works on contiguous element data.
@@ -29,6 +30,10 @@ struct LocalSystem {
   IntMatrix dofs;  // [entity][k]: overlapped dof ids (3 * node + component)
   Matrix R;        // [entity][k]
   bool stiff = false;  // whether the entities have a tangent (dead loads have none)
+  // The entities' residual and tangent rows are their first rowDofs dofs; the
+  // others are columns only (steady friction's upstream nodes and omega).
+  // 0: every dof has a row.
+  int rowDofs = 0;
   // Optional: entities with active(e) == 0 contribute nothing this evaluation
   // (contact faces away from the capstan); empty = all active. The matrix
   // graph still holds them, so the sparsity pattern never changes.
@@ -128,6 +133,11 @@ class Effect {
   const LocalSystem& local() const { return local_; }
   long launches() const { return launches_; }
   double seconds() const { return seconds_; }
+
+  // Called once by the assembly, after it numbered the rigid cores' unknowns
+  // and before it builds the matrix graph: an effect whose entities couple to
+  // a core's unknowns adds them to its dofs here (steady friction's omega).
+  virtual void bindCores(const RigidCores& /*cores*/) {}
 
   // The load increment being solved, from tStart (the last converged state) to
   // tEnd: effects that move with time (capstans) evaluate at tEnd.

@@ -57,7 +57,11 @@ SceneEffects buildEffects(const Mesh& mesh, const Scene& scene) {
     const ContactEffect& contact = *effect;
     out.all.push_back(std::move(effect));
     if (!c.friction.on()) continue;  // no friction kernel at all
-    auto friction = std::make_unique<FrictionEffect>("friction:" + c.name, mesh, quads, contact, c.friction);
+    std::unique_ptr<FrictionEffect> friction;
+    if (scene.analysis.steady())
+      friction = std::make_unique<SteadyFrictionEffect>("friction:" + c.name, mesh, quads, contact, c.friction, scene);
+    else
+      friction = std::make_unique<FrictionEffect>("friction:" + c.name, mesh, quads, contact, c.friction);
     out.frictions.back() = friction.get();
     out.all.push_back(std::move(friction));
   }

@@ -11,6 +11,7 @@
 #include "effect.hpp"
 #include "foundation.hpp"
 #include "friction.hpp"
+#include "steady_friction.hpp"
 
 namespace capstan {
 

@@ -21,10 +21,6 @@ static_assert(int(FrictionSettings::Law::Tanh) == int(kernels::FrictionLaw::Tanh
                   int(FrictionSettings::Law::Coulomb) == int(kernels::FrictionLaw::Coulomb),
               "FrictionSettings::Law names kernels::FrictionLaw's values");
 
-namespace {
-constexpr int kHistoryPerFace = 12 + 3 * kernels::kMaxFacePoints;
-enum FrictionField { kTraction = 0, kNormal = 3, kSlip, kState, kFWeight, kFE, kWork = kFE + 3 };
-}  // namespace
 
 FrictionEffect::FrictionEffect(const std::string& name, const Mesh& mesh,
                                const std::vector<int>& quads, const ContactEffect& contact,

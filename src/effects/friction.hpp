@@ -28,7 +28,7 @@ class FrictionEffect : public Effect {
   // to the traction after each converged solve (Uzawa), so sticking points
   // stick exactly (no elastic slip of size eps_t t) whatever the tangential
   // penalty. Violation: eps_t |t - lambda_T|, the slip of a sticking point.
-  bool augmented() const {
+  virtual bool augmented() const {
     return settings_.law == FrictionSettings::Law::Coulomb && contact_.settings().exact();
   }
   Kokkos::View<double*> multipliers() override {
@@ -52,6 +52,14 @@ class FrictionEffect : public Effect {
     double work = 0;                // sum of w x the work dissipated in the increment
   };
   Figures figures() const;
+  // Per face and point at the last evaluation (host copy): traction (3), t_n,
+  // slip (in the increment; steady rolling: per unit time), state, weight,
+  // e (3), work (likewise).
+  enum Field { kTraction = 0, kNormal = 3, kSlip, kState, kFWeight, kFE, kWork = kFE + 3 };
+  using Points = Kokkos::View<double** [11], Kokkos::LayoutRight>;
+  Points::HostMirror pointsOnHost() const { return Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), points_); }
+  // Slip rate per unit of the points' slip: 1 / the increment's length.
+  double slipRateScale() const { return dt_ > 0 ? 1 / dt_ : 0.0; }
   // Per face: mean friction traction (3), stick and slip point counts.
   void faceFields(std::vector<double>& traction, std::vector<double>& stick,
                   std::vector<double>& slip) const;
@@ -59,7 +67,7 @@ class FrictionEffect : public Effect {
  protected:
   void launch(const NodalVectors& x, const NodalVectors& u, bool tangent, const TangentSink& sink) override;
 
- private:
+  // Shared with SteadyFrictionEffect (src/effects/steady_friction.hpp).
   const ContactEffect& contact_;
   Kokkos::View<int* [4], Kokkos::LayoutRight> nodes_;
   Kokkos::View<double* [4][3], Kokkos::LayoutRight> X_;
@@ -67,8 +75,8 @@ class FrictionEffect : public Effect {
   // [face][12 + 3q + i]: Coulomb's traction at point q from that state.
   Kokkos::View<double*> history_;
   Kokkos::View<double*> tangentialMultipliers_;  // [(face * kMaxFacePoints + q) * 3 + i]
-  // Per face and point at the last evaluation: traction (3), t_n, slip, state, weight, e (3), work.
-  Kokkos::View<double** [11], Kokkos::LayoutRight> points_;
+  static constexpr int kHistoryPerFace = 12 + 3 * kernels::kMaxFacePoints;
+  Points points_;
   FrictionSettings settings_;
   double dt_ = 0;  // the increment's length (setInterval)
   kernels::FrictionParameters parameters_;

@@ -1,0 +1,36 @@
+// Steady rolling (formulation.md §8): each load step's steady state, solved
+// from the previous one (a continuation in the loads). The first comes from
+// rest without the user's help, in three solves: the frictionless footprint
+// with each free core's angular velocity held at the no-slip value, then
+// friction at that angular velocity, then the angular velocity let free.
+#pragma once
+
+#include <string>
+
+#include "augmentation.hpp"
+#include "log.hpp"
+#include "model.hpp"
+#include "step_record.hpp"
+
+namespace capstan {
+
+class SteadyRolling {
+ public:
+  // started: u already holds a steady state (a restart).
+  SteadyRolling(Model& model, Log& log, AugmentationLoop& augmentation, bool started);
+  // The steady state at the loads of time t, from the one in u. False with
+  // `failure` as AugmentationLoop::solve (the caller restores u).
+  bool solve(double t, StepRecord& rec, std::string& failure);
+
+ private:
+  bool solveStage(double t, const char* what, StepRecord& rec, std::string& failure);
+  void holdCores(bool hold);
+  void enableFriction(bool on);
+
+  Model& m_;
+  Log& log_;
+  AugmentationLoop& augmentation_;
+  bool started_;
+};
+
+}  // namespace capstan
