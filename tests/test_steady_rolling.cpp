@@ -1,0 +1,170 @@
+// Steady rolling (formulation.md §8): the assembled tangent of a scene with
+// steady friction (the slip rate from upwind differences along the rings, the
+// core's angular velocity an unknown) against central differences of the
+// assembled residual, for each friction law and upwind order, on 1 and 2
+// ranks; omega's column on its own; the scene checks of Analysis/Type.
+#include <Tpetra_Core.hpp>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "assembly.hpp"
+#include "errors.hpp"
+#include "scene.hpp"
+
+using namespace capstan;
+
+namespace {
+
+const char* kScene = R"xml(<ParameterList name="Scene">
+  <ParameterList name="Analysis"><Parameter name="Type" type="string" value="Steady Rolling"/></ParameterList>
+  <ParameterList name="Mesh">
+    <Parameter name="Type" type="string" value="Annulus"/>
+    <Parameter name="Inner Radius" type="double" value="1"/>
+    <Parameter name="Outer Radius" type="double" value="2"/>
+    <Parameter name="Length" type="double" value="0.6"/>
+    <Parameter name="Cells" type="Array(int)" value="{2, 16, 2}"/>
+    <Parameter name="Fine Sector" type="Array(double)" value="{-90, 80, 0.5}"/>
+  </ParameterList>
+  <ParameterList name="Material"><Parameter name="c" type="double" value="1.3"/></ParameterList>
+  <ParameterList name="Supports">
+    <ParameterList name="core">
+      <Parameter name="Face" type="string" value="inner"/>
+      <Parameter name="Type" type="string" value="Rigid Core"/>
+      <Parameter name="Free Translation" type="string" value="xy"/>
+      <Parameter name="Force" type="Array(double)" value="{0.3, -0.5, 0}"/>
+      <Parameter name="Rotation" type="string" value="Free"/>
+      <Parameter name="Torque" type="double" value="0.2"/>
+    </ParameterList>
+  </ParameterList>
+  <ParameterList name="Capstans">
+    <ParameterList name="capstan">
+      <Parameter name="Radius" type="double" value="1"/>
+      <Parameter name="Axis Point" type="Array(double)" value="{0, -2.9, 0}"/>
+      <Parameter name="Angular Velocity" type="double" value="0.5"/>
+      <Parameter name="Contact Faces" type="string" value="outer"/>
+      <ParameterList name="Contact"><Parameter name="Penalty" type="double" value="0.05"/></ParameterList>
+      <ParameterList name="Friction">
+        <Parameter name="Law" type="string" value="Tanh"/>
+        <Parameter name="Coefficient" type="double" value="0.6"/>
+        <Parameter name="Regularization" type="double" value="0.05"/>
+      </ParameterList>
+    </ParameterList>
+  </ParameterList>
+  <ParameterList name="Output"><Parameter name="Directory" type="string" value="unused"/></ParameterList>
+</ParameterList>)xml";
+
+// A smooth field on the free dofs; the core's translation and angular velocity.
+void fill(const Assembly& a, const Mesh& mesh, Vector& v, double scale, double phase, double omega) {
+  auto d = v.getDataNonConst();
+  for (size_t n = 0; n < mesh.numOwnedNodes; ++n)
+    for (int i = 0; i < 3; ++i)
+      d[3 * n + i] = scale * std::sin(1.3 * mesh.X[3 * n] + 0.7 * mesh.X[3 * n + 1] + 2 * mesh.X[3 * n + 2] + i + phase);
+  if (a.ownedCoreDof(0, 0) >= 0) {
+    d[a.ownedCoreDof(0, 0)] = 0.4 * scale * std::cos(phase);
+    d[a.ownedCoreDof(0, 1)] = -0.3 * scale;
+    d[a.ownedCoreDof(0, 3)] = omega;
+  }
+}
+
+struct Case {
+  const char* name;
+  std::vector<std::string> sets;
+};
+
+class SteadyTangent : public ::testing::TestWithParam<Case> {};
+
+// Relative error of W v against the central difference of the residual along v.
+double tangentError(Assembly& assembly, const Vector& u, const Vector& v, double& scale) {
+  const auto map = assembly.dofMap();
+  Vector f(map), fp(map), fm(map), Wv(map), trial(map);
+  auto W = assembly.createMatrix();
+  EXPECT_TRUE(assembly.evaluate(u, &f, W.get()));
+  W->apply(v, Wv);
+  const double h = 1e-6;
+  trial.update(1.0, u, h, v, 0.0);
+  EXPECT_TRUE(assembly.evaluate(trial, &fp, nullptr));
+  trial.update(1.0, u, -h, v, 0.0);
+  EXPECT_TRUE(assembly.evaluate(trial, &fm, nullptr));
+  Vector diff(map);
+  diff.update(1 / (2 * h), fp, -1 / (2 * h), fm, 0.0);
+  diff.update(-1.0, Wv, 1.0);
+  scale = Wv.norm2();
+  return diff.norm2() / scale;
+}
+
+TEST_P(SteadyTangent, MatchesCentralDifferences) {
+  const Case k = GetParam();
+  const Scene scene = parseScene(kScene, "steady-test.xml", k.sets, "");
+  const auto& m = scene.mesh;
+  AnnulusGenerator gen(m.center, m.innerRadius, m.outerRadius, m.length, m.cells, m.outerCellRatio, m.fineSector);
+  Mesh mesh = distributeMesh(gen, Tpetra::getDefaultComm(), Partition::Metis, {"outer"});
+  Assembly assembly(mesh, scene);
+  ASSERT_EQ(assembly.frictions().size(), 1u);
+  ASSERT_NE(dynamic_cast<const SteadyFrictionEffect*>(assembly.frictions()[0]), nullptr);
+  const auto map = assembly.dofMap();
+  Vector u(map), v(map);
+  // Near the no-slip angular velocity -omega_c R_c / R = -0.25: some points
+  // stick, some slip.
+  fill(assembly, mesh, u, 0.02, 0.0, -0.23);
+  assembly.setInterval(0.0, 0.5);
+  assembly.applyConstraints(u, 0.5);
+  fill(assembly, mesh, v, 1.0, 0.4, 0.7);
+  {
+    auto d = v.getDataNonConst();
+    for (LO i = 0; i < LO(d.size()); ++i)
+      if (assembly.ownedConstrained(i)) d[i] = 0;
+  }
+  double scale = 0;
+  const double err = tangentError(assembly, u, v, scale);
+  const auto ff = assembly.frictions()[0]->figures();
+  long stick = ff.stick, slip = ff.slip;
+  Teuchos::reduceAll(*mesh.comm, Teuchos::REDUCE_SUM, ff.stick, Teuchos::outArg(stick));
+  Teuchos::reduceAll(*mesh.comm, Teuchos::REDUCE_SUM, ff.slip, Teuchos::outArg(slip));
+  EXPECT_GT(stick + slip, 4) << k.name << ": the capstan must press";
+  EXPECT_LT(err, 1e-6) << k.name << " |W v| = " << scale;
+  // omega's column alone, where omega is an unknown: friction is the only
+  // thing that sees it.
+  if (!assembly.rigidCores().at(0).free[3]) return;
+  Vector e(map);
+  if (assembly.ownedCoreDof(0, 3) >= 0) e.getDataNonConst()[assembly.ownedCoreDof(0, 3)] = 1.0;
+  const double errOmega = tangentError(assembly, u, e, scale);
+  EXPECT_GT(scale, 1e-4) << k.name << ": omega's column is empty";
+  EXPECT_LT(errOmega, 1e-6) << k.name << " (omega's column)";
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Steady, SteadyTangent,
+    ::testing::Values(Case{"tanh, second order", {}},
+                      Case{"tanh, first order", {"Analysis/Upwind Order=1"}},
+                      Case{"arctan, second order", {"Capstans/capstan/Friction/Law=Arctan"}},
+                      Case{"coulomb, second order",
+                           {"Capstans/capstan/Friction/Law=Coulomb", "Capstans/capstan/Friction/Tangential Penalty=0.5"}},
+                      Case{"tanh, braked by a prescribed rotation",
+                           {"Supports/core/Rotation=Prescribed", "Supports/core/Angular Velocity=-0.2",
+                            "Supports/core/Torque=0"}}));
+
+// Analysis/Type = Steady Rolling needs an annulus about its own axis on a
+// Rigid Core or Fixed inner face, and capstans parallel to it that stay put.
+TEST(SteadyScene, RejectsWhatItCannotSolve) {
+  auto fails = [](const std::vector<std::string>& sets, const std::string& path) {
+    try {
+      parseScene(kScene, "steady-test.xml", sets, "");
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+      return;
+    }
+    ADD_FAILURE() << "accepted: " << path;
+  };
+  EXPECT_NO_THROW(parseScene(kScene, "steady-test.xml", {}, ""));
+  fails({"Capstans/capstan/Axis Direction={0.1,0,1}"}, "Capstans/capstan/Axis Direction");
+  fails({"Capstans/capstan/Velocity={0.1,0,0}"}, "Capstans/capstan/Velocity");
+  fails({"Capstans/capstan/Angular Velocity=0"}, "Capstans/capstan/Angular Velocity");
+  fails({"Supports/core/Axis Point={0.1,0,0}"}, "Supports/core/Axis Point");
+  fails({"Supports/core/Axis Direction={0,1,1}"}, "Supports/core/Axis Direction");
+  fails({"Analysis/Upwind Order=3"}, "Analysis/Upwind Order");
+  fails({"Analysis/Type=Steady"}, "Analysis/Type");
+}
+
+}  // namespace
