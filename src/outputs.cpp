@@ -171,23 +171,25 @@ void Outputs::writeFields(int step, double time) {
   Field ft{"friction_traction", 3, std::vector<double>(3 * nf, 0.0)};
   Field stick{"stick_points", 1, std::vector<double>(nf, 0.0)};
   Field slip{"slip_points", 1, std::vector<double>(nf, 0.0)};
+  Field rate{"slip_rate", 1, std::vector<double>(nf, 0.0)};
   bool anyFriction = false;
   for (size_t c = 0; c < contacts.size(); ++c) {
     const auto* friction = assembly.frictions()[c];
     if (!friction) continue;
     anyFriction = true;
-    std::vector<double> tc, sc, lc;
-    friction->faceFields(tc, sc, lc);
+    std::vector<double> tc, sc, lc, rc;
+    friction->faceFields(tc, sc, lc, rc);
     const auto& index = assembly.contactFacesOf(c);
     for (size_t f = 0; f < index.size(); ++f) {
       for (int i = 0; i < 3; ++i) ft.values[3 * index[f] + i] += tc[3 * f + i];
       stick.values[index[f]] += sc[f];
       slip.values[index[f]] += lc[f];
+      rate.values[index[f]] += rc[f];
     }
   }
   std::vector<Field> faceFields;
   if (m_.numContactFaces > 0) faceFields = {cp, gap, ct};
-  if (anyFriction) faceFields.insert(faceFields.end(), {ft, stick, slip});
+  if (anyFriction) faceFields.insert(faceFields.end(), {ft, stick, slip, rate});
   writer_->writeStep(step, time, coords, {disp}, {p, vm, sig}, faceFields);
   outputSeconds_ += since(t);
 }

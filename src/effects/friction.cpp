@@ -189,25 +189,29 @@ FrictionEffect::Figures FrictionEffect::figures() const {
 }
 
 void FrictionEffect::faceFields(std::vector<double>& traction, std::vector<double>& stick,
-                                std::vector<double>& slip) const {
+                                std::vector<double>& slip, std::vector<double>& slipRate) const {
   auto pts = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), points_);
   const int nq = kernels::facePointCount(contact_.rule());
   const size_t nf = pts.extent(0);
   traction.assign(3 * nf, 0.0);
   stick.assign(nf, 0.0);
   slip.assign(nf, 0.0);
+  slipRate.assign(nf, 0.0);
   for (size_t f = 0; f < nf; ++f) {
     double area = 0;
     for (int q = 0; q < nq; ++q) {
       const double w = pts(f, q, kFWeight);
       area += w;
       for (int i = 0; i < 3; ++i) traction[3 * f + i] += w * pts(f, q, kTraction + i);
+      slipRate[f] += w * pts(f, q, kSlip) * slipRateScale();
       const int state = int(pts(f, q, kState));
       if (state == 1) stick[f] += 1;
       if (state == 2) slip[f] += 1;
     }
-    if (area > 0)
+    if (area > 0) {
       for (int i = 0; i < 3; ++i) traction[3 * f + i] /= area;
+      slipRate[f] /= area;
+    }
   }
 }
 

@@ -60,9 +60,10 @@ class FrictionEffect : public Effect {
   Points::HostMirror pointsOnHost() const { return Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), points_); }
   // Slip rate per unit of the points' slip: 1 / the increment's length.
   double slipRateScale() const { return dt_ > 0 ? 1 / dt_ : 0.0; }
-  // Per face: mean friction traction (3), stick and slip point counts.
+  // Per face: mean friction traction (3), stick and slip point counts, mean
+  // slip rate (the increment's slip over its length; steady: the slip rate).
   void faceFields(std::vector<double>& traction, std::vector<double>& stick,
-                  std::vector<double>& slip) const;
+                  std::vector<double>& slip, std::vector<double>& slipRate) const;
 
  protected:
   void launch(const NodalVectors& x, const NodalVectors& u, bool tangent, const TangentSink& sink) override;
