@@ -41,6 +41,7 @@ struct Case {
   double axis[3];
   double history;      // Coulomb: magnitude of last step's traction
   int expectState;     // every point: 1 stick, 2 slip (0: do not check)
+  double smoothing = 0;  // Coulomb: the smoothed stick/slip corner's width
 };
 
 std::vector<double> residual(const double X[4][3], const double x[4][3], const double xn[4][3],
@@ -66,6 +67,7 @@ TEST_P(FrictionTangent, MatchesCentralDifferences) {
   fp.tangentPenalty = k.tangentPenalty;
   for (int i = 0; i < 3; ++i) fp.ds[i] = k.ds[i];
   fp.spin = k.spin;
+  fp.smoothing = k.smoothing;
   double lambda[kMaxFacePoints] = {}, h[3 * kMaxFacePoints];
   for (int q = 0; q < kMaxFacePoints; ++q) {
     h[3 * q] = k.history * (1 + 0.1 * q);
@@ -98,37 +100,32 @@ TEST_P(FrictionTangent, MatchesCentralDifferences) {
         nearSwitch = nearSwitch || tmag > k.mu * pts[q].normal * (1 - 1e-4);
     }
     if (nearSwitch) continue;
-    const double hx = 1e-6;
-    double maxErr = 0, scale = 0;
-    for (int col = 0; col < 12; ++col) {
-      x[col / 3][col % 3] += hx;
-      const auto Rp = residual(X, x, xn, cyl, fp, lambda, h);
-      x[col / 3][col % 3] -= 2 * hx;
-      const auto Rm = residual(X, x, xn, cyl, fp, lambda, h);
-      x[col / 3][col % 3] += hx;
-      for (int row = 0; row < 12; ++row) {
-        const double fd = (Rp[row] - Rm[row]) / (2 * hx);
-        maxErr = std::max(maxErr, std::fabs(K[row * 12 + col] - fd));
-        scale = std::max(scale, std::fabs(fd));
+    // The largest error of the tangent `T` against central differences of the
+    // residual with respect to `y` (x, or xn), relative to the largest entry.
+    auto fdError = [&](double (&y)[4][3], const std::vector<double>& T, double& scale) {
+      const double hx = 1e-6;
+      double maxErr = 0;
+      scale = 0;
+      for (int col = 0; col < 12; ++col) {
+        y[col / 3][col % 3] += hx;
+        const auto Rp = residual(X, x, xn, cyl, fp, lambda, h);
+        y[col / 3][col % 3] -= 2 * hx;
+        const auto Rm = residual(X, x, xn, cyl, fp, lambda, h);
+        y[col / 3][col % 3] += hx;
+        for (int row = 0; row < 12; ++row) {
+          const double fd = (Rp[row] - Rm[row]) / (2 * hx);
+          maxErr = std::max(maxErr, std::fabs(T[row * 12 + col] - fd));
+          scale = std::max(scale, std::fabs(fd));
+        }
       }
-    }
-    EXPECT_LT(maxErr / scale, 1e-6) << k.name << " position " << pos;
+      return maxErr / scale;
+    };
+    double scale = 0, scaleN = 0;
+    EXPECT_LT(fdError(x, K, scale), 1e-6) << k.name << " position " << pos;
     // dR/dxn (steady rolling: xn is the upstream nodes' position, an unknown).
-    double maxErrN = 0, scaleN = 0;
-    for (int col = 0; col < 12; ++col) {
-      xn[col / 3][col % 3] += hx;
-      const auto Rp = residual(X, x, xn, cyl, fp, lambda, h);
-      xn[col / 3][col % 3] -= 2 * hx;
-      const auto Rm = residual(X, x, xn, cyl, fp, lambda, h);
-      xn[col / 3][col % 3] += hx;
-      for (int row = 0; row < 12; ++row) {
-        const double fd = (Rp[row] - Rm[row]) / (2 * hx);
-        maxErrN = std::max(maxErrN, std::fabs(Kn[row * 12 + col] - fd));
-        scaleN = std::max(scaleN, std::fabs(fd));
-      }
-    }
+    const double errN = fdError(xn, Kn, scaleN);
     EXPECT_GT(scaleN, 0) << k.name;
-    EXPECT_LT(maxErrN / scaleN, 1e-6) << k.name << " position " << pos << " (dR/dxn)";
+    EXPECT_LT(errN, 1e-6) << k.name << " position " << pos << " (dR/dxn)";
     ++checked;
   }
   EXPECT_GE(checked, 4) << k.name;
@@ -147,7 +144,8 @@ INSTANTIATE_TEST_SUITE_P(
         Case{"coulomb stick, rolling", FrictionLaw::Coulomb, 5.0, 0, 0.1, {0, 0, 0}, 0.01, {0, 0, 1}, 0.05, 1},
         Case{"coulomb slip, rolling", FrictionLaw::Coulomb, 0.1, 0, 1e-3, {0, 0, 0}, 0.05, {0, 0, 1}, 0.05, 2},
         Case{"coulomb slip, translating, skewed", FrictionLaw::Coulomb, 0.2, 0, 1e-3, {0.03, 0, 0.02}, 0, {0.2, 0.1, 1}, 0.1, 2},
-        Case{"coulomb stick, skewed, history", FrictionLaw::Coulomb, 10.0, 0, 0.05, {0.001, 0, 0}, 0.002, {0.1, -0.2, 1}, 0.2, 1}));
+        Case{"coulomb stick, skewed, history", FrictionLaw::Coulomb, 10.0, 0, 0.05, {0.001, 0, 0}, 0.002, {0.1, -0.2, 1}, 0.2, 1},
+        Case{"coulomb, smoothed corner", FrictionLaw::Coulomb, 0.3, 0, 1e-2, {0, 0, 0}, 0.01, {0, 0, 1}, 0.05, 0, 0.3}));
 
 // psi = phi(s)/s and chi = psi'(s)/s against finite differences of phi(s)/s,
 // across the series/closed-form switch, and finite at s = 0.
