@@ -11,49 +11,24 @@
 
 #include "assembly.hpp"
 #include "errors.hpp"
+#include "roller_scene.hpp"
 #include "scene.hpp"
 
 using namespace capstan;
 
 namespace {
 
-const char* kScene = R"xml(<ParameterList name="Scene">
-  <ParameterList name="Analysis"><Parameter name="Type" type="string" value="Steady Rolling"/></ParameterList>
-  <ParameterList name="Mesh">
-    <Parameter name="Type" type="string" value="Annulus"/>
-    <Parameter name="Inner Radius" type="double" value="1"/>
-    <Parameter name="Outer Radius" type="double" value="2"/>
-    <Parameter name="Length" type="double" value="0.6"/>
-    <Parameter name="Cells" type="Array(int)" value="{2, 16, 2}"/>
-    <Parameter name="Fine Sector" type="Array(double)" value="{-90, 80, 0.5}"/>
-  </ParameterList>
-  <ParameterList name="Material"><Parameter name="c" type="double" value="1.3"/></ParameterList>
-  <ParameterList name="Supports">
-    <ParameterList name="core">
-      <Parameter name="Face" type="string" value="inner"/>
-      <Parameter name="Type" type="string" value="Rigid Core"/>
-      <Parameter name="Free Translation" type="string" value="xy"/>
-      <Parameter name="Force" type="Array(double)" value="{0.3, -0.5, 0}"/>
-      <Parameter name="Rotation" type="string" value="Free"/>
-      <Parameter name="Torque" type="double" value="0.2"/>
-    </ParameterList>
-  </ParameterList>
-  <ParameterList name="Capstans">
-    <ParameterList name="capstan">
-      <Parameter name="Radius" type="double" value="1"/>
-      <Parameter name="Axis Point" type="Array(double)" value="{0, -2.9, 0}"/>
-      <Parameter name="Angular Velocity" type="double" value="0.5"/>
-      <Parameter name="Contact Faces" type="string" value="outer"/>
-      <ParameterList name="Contact"><Parameter name="Penalty" type="double" value="0.05"/></ParameterList>
-      <ParameterList name="Friction">
-        <Parameter name="Law" type="string" value="Tanh"/>
-        <Parameter name="Coefficient" type="double" value="0.6"/>
-        <Parameter name="Regularization" type="double" value="0.05"/>
-      </ParameterList>
-    </ParameterList>
-  </ParameterList>
-  <ParameterList name="Output"><Parameter name="Directory" type="string" value="unused"/></ParameterList>
-</ParameterList>)xml";
+// The rigid-core test roller (tests/roller_scene.hpp) made a steady-rolling
+// scene: its core on the annulus axis, a fine sector at the nip, a sharper Tanh.
+const std::vector<std::string> kSteady = {
+    "Analysis/Type=Steady Rolling",           "Supports/core/Axis Point={0, 0, 0}",
+    "Supports/core/Axis Direction={0, 0, 1}", "Mesh/Cells={2, 16, 2}",
+    "Mesh/Fine Sector={-90, 80, 0.5}",        "Capstans/capstan/Friction/Regularization=0.05"};
+
+Scene steadyScene(std::vector<std::string> sets) {
+  sets.insert(sets.begin(), kSteady.begin(), kSteady.end());
+  return parseScene(test::kRollerScene, "steady-test.xml", sets, "");
+}
 
 // A smooth field on the free dofs; the core's translation and angular velocity.
 void fill(const Assembly& a, const Mesh& mesh, Vector& v, double scale, double phase, double omega) {
@@ -96,7 +71,7 @@ double tangentError(Assembly& assembly, const Vector& u, const Vector& v, double
 
 TEST_P(SteadyTangent, MatchesCentralDifferences) {
   const Case k = GetParam();
-  const Scene scene = parseScene(kScene, "steady-test.xml", k.sets, "");
+  const Scene scene = steadyScene(k.sets);
   const auto& m = scene.mesh;
   AnnulusGenerator gen(m.center, m.innerRadius, m.outerRadius, m.length, m.cells, m.outerCellRatio, m.fineSector);
   Mesh mesh = distributeMesh(gen, Tpetra::getDefaultComm(), Partition::Metis, {"outer"});
@@ -150,14 +125,14 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(SteadyScene, RejectsWhatItCannotSolve) {
   auto fails = [](const std::vector<std::string>& sets, const std::string& path) {
     try {
-      parseScene(kScene, "steady-test.xml", sets, "");
+      steadyScene(sets);
     } catch (const InputError& e) {
       EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
       return;
     }
     ADD_FAILURE() << "accepted: " << path;
   };
-  EXPECT_NO_THROW(parseScene(kScene, "steady-test.xml", {}, ""));
+  EXPECT_NO_THROW(steadyScene({}));
   fails({"Capstans/capstan/Axis Direction={0.1,0,1}"}, "Capstans/capstan/Axis Direction");
   fails({"Capstans/capstan/Velocity={0.1,0,0}"}, "Capstans/capstan/Velocity");
   fails({"Capstans/capstan/Angular Velocity=0"}, "Capstans/capstan/Angular Velocity");
