@@ -38,7 +38,7 @@ Model::Model(const Scene& scene_, const RCP<const Comm>& comm_)
                                       [](const CapstanSpec& c) { return c.friction.on(); });
     newton = std::make_unique<NewtonSolver>(
         *assembly, scene.solver.resolved(long(assembly->dofMap()->getGlobalNumElements()),
-                                         m.type == MeshSpec::Type::Annulus, friction));
+                                         m.type == MeshSpec::Type::Annulus, friction, scene.analysis.steady()));
   } catch (const InputError& e) {  // the Solver/NOX or Solver/Stratimikos sublist
     throw InputError(scene.file + ": " + e.what());
   }

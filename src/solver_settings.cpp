@@ -119,9 +119,20 @@ SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterRe
   return s;
 }
 
-SolverSettings SolverSettings::resolved(long dofs, bool annulus, bool friction) const {
+SolverSettings SolverSettings::resolved(long dofs, bool annulus, bool friction, bool steady) const {
   SolverSettings s = *this;
   s.gradedRings = gradedRings || annulus;  // NewtonSolver resolves again, knowing no mesh
+  if (s.linearSolver == LinearSolver::Auto && steady) {
+    // Steady rolling: most Newton iterations are augmentation passes near the
+    // answer, where a factorisation kept across iterations wins (the 3D drive
+    // 7.4-8.2 s against 8.0-8.6 s factorising each time, the slice's brake
+    // sweep 2.1 against 2.8 s, the Carter coating 37 against 51 s; same
+    // iterations and answers: docs/steady-rolling.md). At
+    // any size: omega's row (the torque balance) has no diagonal, which
+    // smoothers cannot take.
+    s.linearSolver = LinearSolver::GMRES;
+    if (s.preconditioner == Preconditioner::Auto) s.preconditioner = Preconditioner::LU;
+  }
   if (s.linearSolver == LinearSolver::Auto) {
     const long most = s.directSolverMaxDofs > 0 ? s.directSolverMaxDofs : annulus ? 50000 : 5000;
     if (dofs > most) {

@@ -53,7 +53,7 @@ struct SolverSettings {
   // Linear Solver = Auto and Preconditioner = Auto resolved for a problem of
   // `dofs` unknowns on an annulus (or box) mesh, with or without friction
   // (docs/performance.md, "Linear solvers", has the measurements).
-  SolverSettings resolved(long dofs, bool annulus, bool friction) const;
+  SolverSettings resolved(long dofs, bool annulus, bool friction, bool steady = false) const;
   // The defaults (tests, benchmarks).
   static SolverSettings defaults(bool friction = false);
 

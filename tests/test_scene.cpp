@@ -683,6 +683,11 @@ TEST(SolverSettings, AutoResolvesByKindAndSize) {
   EXPECT_EQ(pick(s, 15120, true, false), std::make_pair(S::LinearSolver::GMRES, S::Preconditioner::LU));
   EXPECT_EQ(pick(s, 50001, true, false), std::make_pair(S::LinearSolver::GMRES, S::Preconditioner::MueLu));
   EXPECT_EQ(pick(s, 500, true, false).second, S::Preconditioner::LU);
+  // Steady rolling: a kept factorisation at any size (omega's row has no diagonal).
+  for (long dofs : {1920L, 200000L}) {
+    const S r = s.resolved(dofs, true, true, true);
+    EXPECT_EQ(std::make_pair(r.linearSolver, r.preconditioner), std::make_pair(S::LinearSolver::GMRES, S::Preconditioner::LU));
+  }
   EXPECT_TRUE(s.resolved(60000, true, false).gradedRings) << "an annulus' MueLu smooths for graded rings";
   EXPECT_FALSE(s.resolved(60000, false, false).gradedRings);
   EXPECT_TRUE(s.resolved(60000, true, false).resolved(60000, false, false).gradedRings) << "kept when resolved again";
