@@ -12,7 +12,7 @@ constexpr double kMinimumSubstep = 1.0 / 1024;
 
 LoadStepper::LoadStepper(Model& model, Log& log, bool checkTangent, double tDone)
     : m_(model), log_(log), predictors_(model, log), augmentation_(model, log, checkTangent),
-      steady_(model, log, augmentation_, tDone > 0), tDone_(tDone) {}
+      steady_(model, log, augmentation_, predictors_, tDone > 0), tDone_(tDone) {}
 
 bool LoadStepper::solveIncrement(double t0, double t1, StepRecord& rec, std::string& failure) {
   m_.assembly->setInterval(t0, t1);

@@ -31,6 +31,17 @@ double Predictors::firstGuess(double t0, double t, StepRecord& rec) {
   return bare;
 }
 
+void Predictors::linearResponse(double t, StepRecord& rec) {
+  auto& assembly = *m_.assembly;
+  assembly.applyConstraints(*m_.u, t);
+  Vector f(m_.u->getMap());
+  assembly.evaluate(*m_.u, &f, nullptr);
+  const double bare = f.norm2();
+  if (m_.scene.solver.predictor == SolverSettings::Predictor::Tangent && bare > 1e-8 * m_.forceScale)
+    tangent(t, t, bare, rec);
+  assembly.applyConstraints(*m_.u, t);
+}
+
 void Predictors::remember(const Vector& before, double tBefore, std::vector<double> rotationsBefore) {
   previous_ = rcp(new Vector(before, Teuchos::Copy));
   tPrevious_ = tBefore;

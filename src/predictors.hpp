@@ -24,6 +24,9 @@ class Predictors {
   // The state before the increment that just converged (u, its time and the
   // cores' rotations): the base of the rolling extrapolation.
   void remember(const Vector& before, double tBefore, std::vector<double> rotationsBefore);
+  // Steady rolling's start from rest: the tangent predictor alone, at the
+  // loads of time t (no rolling measures: the steady mesh does not turn).
+  void linearResponse(double t, StepRecord& rec);
 
  private:
   // Rolling: u extrapolated along the last converged increment; true if kept.

@@ -8,14 +8,16 @@
 
 namespace capstan {
 
-SteadyRolling::SteadyRolling(Model& model, Log& log, AugmentationLoop& augmentation, bool started)
-    : m_(model), log_(log), augmentation_(augmentation), started_(started) {}
+SteadyRolling::SteadyRolling(Model& model, Log& log, AugmentationLoop& augmentation, Predictors& predictors,
+                             bool started)
+    : m_(model), log_(log), augmentation_(augmentation), predictors_(predictors), started_(started) {}
 
 bool SteadyRolling::solve(double t, StepRecord& rec, std::string& failure) {
   bool ok = true;
   if (!started_) {
     holdCores(true);
     enableFriction(false);
+    predictors_.linearResponse(t, rec);
     ok = solveStage(t, "frictionless footprint", rec, failure);
     enableFriction(true);
     if (ok) ok = solveStage(t, "friction at the no-slip angular velocity", rec, failure);

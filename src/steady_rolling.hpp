@@ -1,7 +1,8 @@
 // Steady rolling (formulation.md §8): each load step's steady state, solved
 // from the previous one (a continuation in the loads). The first comes from
 // rest without the user's help, in three solves: the frictionless footprint
-// with each free core's angular velocity held at the no-slip value, then
+// (from the linear response to the loads, as a quasi-static first step) with
+// each free core's angular velocity held at the no-slip value, then
 // friction at that angular velocity, then the angular velocity let free.
 #pragma once
 
@@ -10,6 +11,7 @@
 #include "augmentation.hpp"
 #include "log.hpp"
 #include "model.hpp"
+#include "predictors.hpp"
 #include "step_record.hpp"
 
 namespace capstan {
@@ -17,7 +19,7 @@ namespace capstan {
 class SteadyRolling {
  public:
   // started: u already holds a steady state (a restart).
-  SteadyRolling(Model& model, Log& log, AugmentationLoop& augmentation, bool started);
+  SteadyRolling(Model& model, Log& log, AugmentationLoop& augmentation, Predictors& predictors, bool started);
   // The steady state at the loads of time t, from the one in u. False with
   // `failure` as AugmentationLoop::solve (the caller restores u).
   bool solve(double t, StepRecord& rec, std::string& failure);
@@ -30,6 +32,7 @@ class SteadyRolling {
   Model& m_;
   Log& log_;
   AugmentationLoop& augmentation_;
+  Predictors& predictors_;
   bool started_;
 };
 
