@@ -31,7 +31,7 @@ json::Object eventOf(const char* name) { return json::Object().add("event", json
 }  // namespace
 
 AugmentationLoop::AugmentationLoop(Model& model, Log& log, bool checkTangent)
-    : m_(model), log_(log), checkTangent_(checkTangent) {}
+    : m_(model), log_(log), checkTangent_(checkTangent), continuation_(model.assembly->frictions(), log) {}
 
 bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string& failure) {
   const auto& sol = m_.scene.solver;
@@ -55,7 +55,18 @@ bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string
       tolIt = std::max(std::min(tol, kLaterPassReduction * f.norm2()), 1e-3 * m_.absTolerance);
     }
     const auto solveStart = Clock::now();
-    const NewtonResult r = m_.newton->solve(*m_.u, tolIt);
+    const Vector start(*m_.u, Teuchos::Copy);
+    NewtonResult r = m_.newton->solve(*m_.u, tolIt);
+    if (!r.converged && continuation_.applies()) {
+      if (log_.on("newton"))
+        log_.event("newton", format("newton failed (%s) in %d iterations: continuation in the friction "
+                                    "regularisation, %d stages", r.failure.c_str(), r.iterations, continuation_.stages()),
+                   eventOf("continuation").add("failed_iterations", json::number(r.iterations)));
+      rec.newton += r.iterations;
+      rec.linear += r.linearIterations;
+      m_.u->update(1.0, start, 0.0);
+      r = continuation_.solve(*m_.newton, *m_.u, tolIt);
+    }
     const double solveSeconds = since(solveStart);
     rec.newton += r.iterations;
     rec.linear += r.linearIterations;

@@ -6,11 +6,13 @@
 // Anderson-accelerated, until every constraint meets its tolerance.
 #pragma once
 
+#include <memory>
 #include <string>
 
 #include "anderson.hpp"
 #include "log.hpp"
 #include "model.hpp"
+#include "regularisation_continuation.hpp"
 #include "step_record.hpp"
 
 namespace capstan {
@@ -38,6 +40,9 @@ class AugmentationLoop {
   Model& m_;
   Log& log_;
   bool checkTangent_;
+  // A failed Newton solve under a regularised friction law is repeated
+  // through wider laws (src/regularisation_continuation.hpp).
+  RegularisationContinuation continuation_;
   std::vector<Kokkos::View<double*>> pressureStepDmu_;  // per effect: its multipliers' change in the step
 };
 

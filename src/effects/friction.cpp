@@ -57,7 +57,20 @@ void FrictionEffect::setInterval(double tStart, double tEnd) {
   parameters_.spin = contact_.capstan().angularVelocity * dt * contact_.radius();
   // The slip-length scale eps3 dt; a zero-length interval (a re-evaluation of a
   // converged state) has no slip, any positive scale gives t_f = 0 there.
-  parameters_.v = settings_.regularization * (dt > 0 ? dt : 1.0);
+  parameters_.v = settings_.regularization * (dt > 0 ? dt : 1.0) * regularisationScale_;
+}
+
+void FrictionEffect::setRegularisationScale(double scale) {
+  parameters_.v *= scale / regularisationScale_;
+  regularisationScale_ = scale;
+}
+
+double FrictionEffect::travelOverSlipScale() const {
+  if (settings_.law != FrictionSettings::Law::Tanh && settings_.law != FrictionSettings::Law::Arctan) return 0;
+  const auto& c = contact_.capstan();
+  const double speed = std::sqrt(c.velocity[0] * c.velocity[0] + c.velocity[1] * c.velocity[1] +
+                                 c.velocity[2] * c.velocity[2]);
+  return (std::fabs(c.angularVelocity) * contact_.radius() + speed) / settings_.regularization;
 }
 
 void FrictionEffect::launch(const NodalVectors& x, const NodalVectors&, bool tangent, const TangentSink& sink) {

@@ -18,6 +18,12 @@ class FrictionEffect : public Effect {
                  const ContactEffect& contact, const FrictionSettings& settings);
 
   void setInterval(double tStart, double tEnd) override;
+  // Tanh and Arctan: the slip scale v is eps3 dt x `scale` (1: the scene's
+  // law; src/regularisation_continuation.hpp widens it for a failed solve).
+  void setRegularisationScale(double scale);
+  // Tanh and Arctan: the capstan surface's travel over the slip scale v
+  // (scale 1), (|omega| R + |velocity|) / eps3, independent of dt; 0 otherwise.
+  double travelOverSlipScale() const;
   // Predictor: every contact point sticks (kernels/friction.hpp).
   void setPredicting(bool on) override { parameters_.stickPredictor = on; }
   Kokkos::View<double*> history() override { return history_; }
@@ -80,6 +86,7 @@ class FrictionEffect : public Effect {
   Points points_;
   FrictionSettings settings_;
   double dt_ = 0;  // the increment's length (setInterval)
+  double regularisationScale_ = 1;
   kernels::FrictionParameters parameters_;
 };
 

@@ -138,7 +138,7 @@ void SteadyFrictionEffect::launch(const NodalVectors& x, const NodalVectors&, bo
   kernels::FrictionParameters fp = parameters_;
   fp.ds[0] = fp.ds[1] = fp.ds[2] = 0;
   const double surfaceSpeed = contact_.capstan().angularVelocity * contact_.radius();
-  const double eps3 = settings_.regularization;
+  const double eps3 = settings_.regularization * regularisationScale_;
   // The flow's angular velocity about +z, times its sign sigma (> 0 when
   // omega is near its no-slip value), and its derivative by omega.
   const double omega = core_ >= 0 ? cores_->records()[core_].angularVelocity : 0.0;

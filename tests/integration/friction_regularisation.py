@@ -1,0 +1,92 @@
+#!/usr/bin/env python3
+"""Tiny friction regularisation (src/regularisation_continuation.hpp): a Newton
+solve that fails under Tanh or Arctan is repeated through wider laws, v x 3^k down
+to the scene's v, within the increment (no step cut).
+
+  * H5 (mu = 0.9), Tanh, exact contact (augmented Lagrangian), Regularization 1e-5
+    (v = 2e-7: the capstan travels 1.25e6 v per step): converges with no step cut; the
+    log shows the continuation ran and ended at the scene's law (3^0); contact exact
+    (max_penetration below 1e-6 of the capstan radius), friction traction within
+    mu t_n (ratio <= 1 + 1e-8), the capstan force equal to the supports' (1e-8); the
+    force of step 1 (partly stuck) within 0.1% of the same scene at Regularization 1e-4,
+    which converges without the continuation, with the same sticking points;
+  * H4 (soft foundation k = 0.1), the study's Tanh law, exact contact, step 1 (partly
+    stuck: the study's failure): converges with no step cut, and its capstan force is
+    Coulomb's (the stick/slip law with exact stick) within 0.5%, with the same number of
+    sticking points.
+"""
+import os
+import sys
+
+sys.dont_write_bytecode = True
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from capstan_test import Test, has_nan  # noqa: E402
+
+T = Test("friction_regularisation", __doc__)
+F = "Capstans/capstan/Friction/"
+AL = "Capstans/capstan/Contact/Method=Augmented Lagrangian"
+RADIUS = 2.0  # the capstan's radius in h4.xml and h5.xml
+
+
+def run(name, sets, tag):
+    scene = T.input(f"seed/{name}.xml")
+    p, s, out = T.run_scene(scene, tag, sets=sets, extra=["--log", "newton"])
+    if s is None or not s["converged"]:
+        T.check(False, f"{tag}: converged ({None if s is None else s['failure']!r})")
+        return None, out
+    T.conforms(out, scene)
+    T.check(not has_nan(s), f"{tag}: no NaN in summary.json")
+    cuts = [st["cutbacks"] for st in s["steps"]]
+    T.check(sum(cuts) == 0, f"{tag}: no step cut ({cuts})")
+    pen = max(st["capstans"]["capstan"]["max_penetration"] for st in s["steps"])
+    T.check(pen <= 1e-6 * RADIUS, f"{tag}: max_penetration {pen:.2e} <= 1e-6 R")
+    ratio = max(st["capstans"]["capstan"]["friction"]["max_traction_ratio"] for st in s["steps"])
+    T.check(ratio <= 1 + 1e-8, f"{tag}: |t_f| / (mu t_n) = {ratio:.10f} <= 1 + 1e-8")
+    for st in s["steps"]:
+        cap = st["capstans"]["capstan"]["force"]
+        sup = [sum(f["force"][i] for f in st["supports"].values()) for i in range(3)]
+        scale = max(abs(x) for x in cap)
+        T.check(max(abs(a - b) for a, b in zip(cap, sup)) <= 1e-8 * scale,
+                f"{tag} step {st['step']}: capstan force = sum of support forces")
+    c = s["steps"][-1]["capstans"]["capstan"]
+    print(f"    {tag:22s} force = [{c['force'][0]:.6f}, {c['force'][1]:.6f}]  stick/slip = "
+          f"{c['stick_points']}/{c['slip_points']}  newton = {[st['newton_iterations'] for st in s['steps']]}")
+    return s, out
+
+
+def stages(out):
+    return [e for e in T.log_events(out) if e.get("event") == "regularisation_stage"]
+
+
+def close(a, b, rel, what):
+    d = max(abs(x - y) for x, y in zip(a, b)) / max(abs(x) for x in b)
+    T.check(d <= rel, f"{what}: {d:.2e} <= {rel}")
+
+
+# H5 at a tiny regularisation.
+tiny, out = run("h5", [AL, F + "Law=Tanh", F + "Regularization=1e-5"], "h5 tanh eps3=1e-5")
+ref, _ = run("h5", [AL, F + "Law=Tanh", F + "Regularization=1e-4"], "h5 tanh eps3=1e-4")
+if tiny:
+    st = stages(out)
+    T.check(len(st) > 0 and st[-1].get("power") == 0 and st[-1].get("converged") in (True, "true"),
+            f"h5 eps3=1e-5: the continuation ran and ended at the scene's law ({len(st)} stages logged)")
+if tiny and ref:
+    # Step 1 is partly stuck (the later steps slip fully, where the laws agree exactly).
+    a, b = tiny["steps"][0]["capstans"]["capstan"], ref["steps"][0]["capstans"]["capstan"]
+    close(a["force"], b["force"], 1e-3, "h5 tanh step 1: capstan force at eps3 1e-5 against 1e-4")
+    T.check(a["stick_points"] == b["stick_points"] > 0,
+            f"h5 tanh step 1: sticking points, {a['stick_points']} at 1e-5 and {b['stick_points']} at 1e-4")
+
+# H4 step 1 with the study's Tanh law, against Coulomb.
+one = "Time/Steps=1"
+tanh, out = run("h4", [one, F + "Law=Tanh"], "h4 tanh step 1")
+coulomb, _ = run("h4", [one, F + "Law=Coulomb"], "h4 coulomb step 1")
+if tanh:
+    T.check(len(stages(out)) > 0, "h4 tanh: the continuation ran")
+if tanh and coulomb:
+    a, b = tanh["steps"][0]["capstans"]["capstan"], coulomb["steps"][0]["capstans"]["capstan"]
+    close(a["force"], b["force"], 5e-3, "h4 step 1: Tanh's capstan force against Coulomb's")
+    T.check(a["stick_points"] == b["stick_points"],
+            f"h4 step 1: sticking points, Tanh {a['stick_points']} and Coulomb {b['stick_points']}")
+
+T.finish()
