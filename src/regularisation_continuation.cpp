@@ -23,9 +23,26 @@ void RegularisationContinuation::setScale(double scale) {
   for (auto* f : frictions_) f->setRegularisationScale(scale);
 }
 
+// The short sequence's first power (see the header).
+constexpr int kShortSequence = 2;
+
 NewtonResult RegularisationContinuation::solve(NewtonSolver& newton, Vector& u, double tolerance) {
   NewtonResult total;
-  for (int k = stages_; k >= 0; --k) {
+  const Vector start(u, Teuchos::Copy);
+  bool converged = sequence(newton, u, tolerance, std::min(kShortSequence, stages_), total);
+  if (!converged && stages_ > kShortSequence) {
+    u.update(1.0, start, 0.0);
+    converged = sequence(newton, u, tolerance, stages_, total);
+  }
+  setScale(1.0);
+  total.converged = converged;
+  if (!converged) total.failure = "continuation in the friction regularisation failed: " + total.failure;
+  return total;
+}
+
+bool RegularisationContinuation::sequence(NewtonSolver& newton, Vector& u, double tolerance, int first,
+                                          NewtonResult& total) {
+  for (int k = first; k >= 0; --k) {
     setScale(std::pow(3.0, k));
     const NewtonResult r = newton.solve(u, tolerance);
     if (log_.on("newton"))
@@ -38,14 +55,10 @@ NewtonResult RegularisationContinuation::solve(NewtonSolver& newton, Vector& u, 
     total.linearIterations += r.linearIterations;
     total.residualHistory.insert(total.residualHistory.end(), r.residualHistory.begin(), r.residualHistory.end());
     total.residualNorm = r.residualNorm;
-    total.converged = r.converged;
     total.failure = r.failure;
-    if (!r.converged) break;
+    if (!r.converged) return false;
   }
-  setScale(1.0);
-  if (!total.converged)
-    total.failure = "continuation in the friction regularisation failed: " + total.failure;
-  return total;
+  return true;
 }
 
 }  // namespace capstan

@@ -9,12 +9,16 @@
 // scale with dt).
 //
 // So when a Newton solve fails with such a law, it is repeated from where it
-// started through a sequence of wider laws, v x 3^k for k = K, ..., 1, each
+// started through a sequence of wider laws, v x 3^k for k = k0, ..., 1, each
 // solve starting from the last, and ends with the scene's own law (k = 0).
-// 3^K is about a third of the travel over v: the first law is smooth on the
-// scale of the increment, and each next one sees its sticking points within a
-// few of its v (3 per stage converged in a handful of Newton iterations each
-// in H4; 10 per stage stagnated).
+// Each law sees its sticking points within a few of its v (3 per stage
+// converged in a handful of Newton iterations each in H4; 10 per stage
+// stagnated). A short sequence first, k0 = 2: a wide law moves a free
+// roller's steady state far from the scene's (the steady slice with Tanh,
+// eps3 = 1e-2, fails from k0 >= 4 and converges from 2 or 3). If that fails,
+// the whole sequence from where the solve started, 3^K about a third of the
+// travel over v: the first law smooth on the scale of the increment (H4's
+// first step and H5 at eps3 = 1e-5 need it).
 #pragma once
 
 #include <string>
@@ -33,13 +37,15 @@ class RegularisationContinuation {
   // Whether a failed solve can be retried this way (some regularised law with
   // travel over slip scale above 3).
   bool applies() const { return stages_ > 0; }
-  // The solve through the stages from u (the failed solve's start, in place).
-  // The iterations of every stage are summed in the result; it fails where a
-  // stage fails.
+  // The solve through the stages from u (the failed solve's start, in place):
+  // the short sequence, then if it fails the whole one. The iterations of
+  // every stage are summed in the result.
   NewtonResult solve(NewtonSolver& newton, Vector& u, double tolerance);
   int stages() const { return stages_; }
 
  private:
+  // Stages 3^first, ..., 3^0 from u; adds to `total`, false where one fails.
+  bool sequence(NewtonSolver& newton, Vector& u, double tolerance, int first, NewtonResult& total);
   void setScale(double scale);
   std::vector<FrictionEffect*> frictions_;
   Log& log_;

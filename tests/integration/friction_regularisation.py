@@ -13,7 +13,11 @@ to the scene's v, within the increment (no step cut).
   * H4 (soft foundation k = 0.1), the study's Tanh law, exact contact, step 1 (partly
     stuck: the study's failure): converges with no step cut, and its capstan force is
     Coulomb's (the stick/slip law with exact stick) within 0.5%, with the same number of
-    sticking points.
+    sticking points;
+  * steady rolling, the free slice (pinch-roller-slice-steady.xml) with Tanh at
+    Regularization 1e-3 (exit 2 without the continuation): converges with no cut, its
+    speed ratio within 1e-5 of Coulomb's (the scene's own law) and the same stick and
+    slip points.
 """
 import os
 import sys
@@ -88,5 +92,24 @@ if tanh and coulomb:
     close(a["force"], b["force"], 5e-3, "h4 step 1: Tanh's capstan force against Coulomb's")
     T.check(a["stick_points"] == b["stick_points"],
             f"h4 step 1: sticking points, Tanh {a['stick_points']} and Coulomb {b['stick_points']}")
+
+# Steady rolling: the free slice with Tanh against Coulomb.
+scene = T.input("pinch-roller-slice-steady.xml")
+p, st, out = T.run_scene(scene, "slice steady tanh", sets=[F + "Law=Tanh", F + "Regularization=1e-3"],
+                         extra=["--log", "newton"])
+p, sc, _ = T.run_scene(scene, "slice steady coulomb")
+if st and sc and st["converged"] and sc["converged"]:
+    T.conforms(out, scene)
+    T.check(sum(x["cutbacks"] for x in st["steps"]) == 0, "slice steady tanh: no step cut")
+    T.check(len(stages(out)) > 0, "slice steady tanh: the continuation ran")
+    a, b = st["steps"][-1], sc["steps"][-1]
+    ra, rb = a["supports"]["core"]["speed_ratio"], b["supports"]["core"]["speed_ratio"]
+    T.check(abs(ra - rb) <= 1e-5, f"slice steady: speed ratio Tanh {ra:.7f}, Coulomb {rb:.7f} (1e-5)")
+    ca, cb = a["capstans"]["capstan"], b["capstans"]["capstan"]
+    T.check((ca["stick_points"], ca["slip_points"]) == (cb["stick_points"], cb["slip_points"]),
+            f"slice steady: stick/slip points, Tanh {ca['stick_points']}/{ca['slip_points']}, "
+            f"Coulomb {cb['stick_points']}/{cb['slip_points']}")
+else:
+    T.check(False, "slice steady: Tanh (eps3 1e-3) and Coulomb converge")
 
 T.finish()
