@@ -16,6 +16,8 @@ iterations per step against the case, failed runs marked).
 
   scripts/friction-bench.py [--capstan build/capstan] [--out out/friction-bench]
                             [--only seed,slice,fast] [--steps 8] [--drive] [--drive-steps 5]
+  scripts/friction-bench.py --replot --out DIR    (the picture again from DIR's CSV)
+Run it with /usr/bin/python3 (Debian's, which has matplotlib).
 """
 import argparse
 import csv
@@ -66,6 +68,32 @@ def cases(a):
         yield "3D drive", "pinch-roller.xml", [f"Time/Steps={a.drive_steps}"]
 
 
+def plot(rows, out):
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        print("matplotlib not found (run with /usr/bin/python3): no picture")
+        return
+    fig, ax = plt.subplots(figsize=(10, 0.28 * len(rows) + 1.5))
+    y = list(range(len(rows)))
+    ax.barh(y, [r["newton_mean"] for r in rows],
+            color=["tab:blue" if r["rc"] == 0 else "tab:red" for r in rows])
+    for i, r in enumerate(rows):
+        ax.text(r["newton_mean"], i, f"  {r['cuts']} cuts" + ("" if r["rc"] == 0 else f", exit {r['rc']}"),
+                va="center", fontsize=7)
+    ax.set_yticks(y)
+    ax.set_yticklabels([r["case"] for r in rows], fontsize=7)
+    ax.invert_yaxis()
+    ax.set_xscale("log")
+    ax.axvline(25, color="gray", ls="--", lw=0.8)
+    ax.set_xlabel("Newton iterations per converged step (mean, log scale; dashed: 25); red: did not finish")
+    ax.set_title("Frictional contact: Newton cost per scene (scripts/friction-bench.py)")
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "friction-bench.png"), dpi=120)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--capstan", default=os.path.join(ROOT, "build", "capstan"))
@@ -74,9 +102,16 @@ def main():
     ap.add_argument("--steps", type=int, default=8, help="steps of each fast roller (default 8)")
     ap.add_argument("--drive", action="store_true", help="also the 3D drive (minutes)")
     ap.add_argument("--drive-steps", type=int, default=5)
+    ap.add_argument("--replot", action="store_true", help="only draw the picture from OUT's CSV")
     a = ap.parse_args()
     a.only = a.only.split(",")
     os.makedirs(a.out, exist_ok=True)
+    if a.replot:
+        with open(os.path.join(a.out, "friction-bench.csv")) as f:
+            rows = [dict(r, rc=int(r["rc"]), newton_mean=float(r["newton_mean"]), cuts=int(r["cuts"]))
+                    for r in csv.DictReader(f)]
+        plot(rows, a.out)
+        return
     rows = []
     print("| case | exit | steps | Newton per step (mean, max) | cuts | wall |\n|---|---|---|---|---|---|")
     for k, (label, scene, sets) in enumerate(cases(a)):
@@ -96,28 +131,7 @@ def main():
         for r in rows:
             f.write(f"| {r['case']} | {r['rc']} | {r['steps']} | {r['newton_mean']:.1f}, {r['newton_max']} | "
                     f"{r['cuts']} | {r['wall']:.1f} s |\n")
-    try:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
-        print("matplotlib not found: no picture")
-        return
-    fig, ax = plt.subplots(figsize=(10, 0.28 * len(rows) + 1.5))
-    y = list(range(len(rows)))
-    ax.barh(y, [r["newton_mean"] for r in rows],
-            color=["tab:blue" if r["rc"] == 0 else "tab:red" for r in rows])
-    for i, r in enumerate(rows):
-        ax.text(r["newton_mean"], i, f"  {r['cuts']} cuts" + ("" if r["rc"] == 0 else f", exit {r['rc']}"),
-                va="center", fontsize=7)
-    ax.set_yticks(y)
-    ax.set_yticklabels([r["case"] for r in rows], fontsize=7)
-    ax.invert_yaxis()
-    ax.axvline(25, color="gray", ls="--", lw=0.8)
-    ax.set_xlabel("Newton iterations per converged step (mean); red: did not finish")
-    ax.set_title("Frictional contact: Newton cost per scene (scripts/friction-bench.py)")
-    fig.tight_layout()
-    fig.savefig(os.path.join(a.out, "friction-bench.png"), dpi=120)
+    plot(rows, a.out)
     print(f"wrote {a.out}/friction-bench.csv, .md, .png")
 
 
