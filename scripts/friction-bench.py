@@ -5,10 +5,11 @@ Runs, one after the other on this machine, and prints per run the exit status, N
 iterations per step (mean and largest), step cuts and wall time:
   * the study's H1-H5 (inputs/seed/) with each law, Tanh, Arctan and Coulomb, and exact
     contact (the augmented Lagrangian);
-  * the rolling slice, inputs/pinch-roller-slice.xml (20 steps);
+  * the rolling slice, inputs/pinch-roller-slice.xml (20 steps), with the streamline shift
+    (the default Solver/Rolling Predictor) and with the rigid roll;
   * fast free rollers: inputs/free-roller-fast.xml (one nip cell per step) and with twice
     its Step Size (two cells), for mu 0.3, 0.6, 0.9 and spring forces 0.125, 0.25, 0.5 N
-    (--steps steps each, default 8);
+    (--steps steps each, default 8); --rolling-predictor "Rigid Roll" runs them with the roll;
   * with --drive, the 3D drive inputs/pinch-roller.xml, its first --drive-steps steps
     (default 5; minutes).
 Writes OUT/friction-bench.csv, OUT/friction-bench.md and OUT/friction-bench.png (Newton
@@ -57,13 +58,14 @@ def cases(a):
                 yield f"{name.upper()} {law}", f"seed/{name}.xml", [AL, F + "Law=" + law]
     if "slice" in a.only:
         yield "slice", "pinch-roller-slice.xml", []
+        yield "slice, rigid roll", "pinch-roller-slice.xml", ["Solver/Rolling Predictor=Rigid Roll"]
     if "fast" in a.only:
         for cells, size in ((1, 0.004), (2, 0.008)):
             for mu in (0.3, 0.6, 0.9):
                 for force in (0.125, 0.25, 0.5):
                     yield (f"fast roller, {cells} cell/step, mu {mu}, {force} N", "free-roller-fast.xml",
                            [f"Time/Step Size={size}", f"Time/Steps={a.steps}", F + f"Coefficient={mu}",
-                            "Supports/core/Force={0, %g, 0}" % -force])
+                            "Supports/core/Force={0, %g, 0}" % -force] + a.predictor)
     if a.drive:
         yield "3D drive", "pinch-roller.xml", [f"Time/Steps={a.drive_steps}"]
 
@@ -103,8 +105,10 @@ def main():
     ap.add_argument("--drive", action="store_true", help="also the 3D drive (minutes)")
     ap.add_argument("--drive-steps", type=int, default=5)
     ap.add_argument("--replot", action="store_true", help="only draw the picture from OUT's CSV")
+    ap.add_argument("--rolling-predictor", default="", help='the fast rollers\' Solver/Rolling Predictor')
     a = ap.parse_args()
     a.only = a.only.split(",")
+    a.predictor = [f"Solver/Rolling Predictor={a.rolling_predictor}"] if a.rolling_predictor else []
     os.makedirs(a.out, exist_ok=True)
     if a.replot:
         with open(os.path.join(a.out, "friction-bench.csv")) as f:

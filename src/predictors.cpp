@@ -19,7 +19,8 @@ double Predictors::firstGuess(double t0, double t, StepRecord& rec) {
   // In steady rolling every increment looks like the one before (the nip has
   // moved on by one increment of the roller's turn), which the linear response
   // from a state at rest cannot see.
-  bool extrapolated = m_.rolling && previous_ && tPrevious_ < t0 && extrapolate(t0, t, bare, f);
+  bool extrapolated = m_.rolling && previous_ && tPrevious_ < t0 &&
+                      (shiftAlongStreamlines(t0, t) || extrapolate(t0, t, bare, f));
   // From the bare state every point of a driven roller's nip slips and the
   // core's rotation has almost no stiffness: turn the body with the core first.
   bool rolled = !extrapolated && rollWithCores(t0, t);
@@ -63,7 +64,7 @@ bool Predictors::extrapolate(double t0, double t, double bare, Vector& f) {
   return true;
 }
 
-bool Predictors::rollWithCores(double t0, double t) {
+std::vector<double> Predictors::coreTurns(double t0, double t) const {
   const auto& cores = m_.assembly->rigidCores();
   std::vector<double> dTheta;
   for (size_t i = 0; i < cores.size(); ++i) {
@@ -76,6 +77,35 @@ bool Predictors::rollWithCores(double t0, double t) {
     }
     dTheta.push_back(omega * (t - t0));
   }
+  return dTheta;
+}
+
+bool Predictors::shiftAlongStreamlines(double t0, double t) {
+  if (m_.scene.solver.rollingPredictor != SolverSettings::RollingPredictor::StreamlineShift || tPrevious_ <= 0)
+    return false;
+  const std::vector<double> dTheta = coreTurns(t0, t);
+  // One turning core: the shift keeps one body's shape about one axis.
+  if (std::count_if(dTheta.begin(), dTheta.end(), [](double x) { return x != 0; }) != 1) return false;
+  const size_t c = size_t(std::find_if(dTheta.begin(), dTheta.end(), [](double x) { return x != 0; }) - dTheta.begin());
+  auto& assembly = *m_.assembly;
+  // Only near rolling: the last increment's turn within 20% of rolling without
+  // slip. A cut step's first sub-step can end with the core turned backwards
+  // (the fast roller at 2 cells per step), and shifting the shape upstream
+  // then fails every later sub-step.
+  const double noSlip = noSlipAngularVelocity(m_.scene, assembly.rigidCores()[c]) * (t - t0);
+  if (!(std::fabs(dTheta[c] / noSlip - 1) < 0.2)) return false;
+  if (!shift_) shift_ = std::make_unique<StreamlineShift>(assembly.mesh(), assembly.dofMap());
+  // The cores' records are the bare state's (firstGuess evaluated it): the
+  // converged translation.
+  shift_->apply(*m_.u, assembly.rigidCores()[c], c, dTheta[c], assembly.ownedCoreDof(c, 3));
+  if (log_.on("newton"))
+    log_.event("newton", format("shifted along the streamlines by %.4g", dTheta[c]),
+               json::Object().add("event", json::string("streamline_shift")).add("angle", json::number(dTheta[c])));
+  return true;
+}
+
+bool Predictors::rollWithCores(double t0, double t) {
+  const std::vector<double> dTheta = coreTurns(t0, t);
   if (std::none_of(dTheta.begin(), dTheta.end(), [](double x) { return x != 0; })) return false;
   m_.assembly->rollWithCores(*m_.u, dTheta);
   if (log_.on("newton"))

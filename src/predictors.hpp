@@ -4,11 +4,13 @@
 // roll with the cores.
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include "log.hpp"
 #include "model.hpp"
 #include "step_record.hpp"
+#include "streamline_shift.hpp"
 
 namespace capstan {
 
@@ -31,9 +33,16 @@ class Predictors {
  private:
   // Rolling: u extrapolated along the last converged increment; true if kept.
   bool extrapolate(double t0, double t1, double bare, Vector& f);
-  // Rolling: the body turned with each free core at its last angular velocity
-  // (at first: rolling without slip); true if any core turned.
+  // Rolling: each free core's turn in the increment, at its last angular
+  // velocity (at first: rolling without slip).
+  std::vector<double> coreTurns(double t0, double t1) const;
+  // Rolling: the body turned with each free core; true if any core turned.
   bool rollWithCores(double t0, double t1);
+  // Rolling, Solver/Rolling Predictor = Streamline Shift (the default), from
+  // the third step on (the second starts from rest: its last increment is no
+  // rolling): the body's shape kept in space as one free core turns
+  // (src/streamline_shift.hpp); true if done.
+  bool shiftAlongStreamlines(double t0, double t1);
   // K_ff du = -(R + K z)_f from the converged state and the prescribed
   // increment z; kept if it beats the bare increment.
   void tangent(double t0, double t1, double bare, StepRecord& rec);
@@ -43,6 +52,7 @@ class Predictors {
   RCP<Vector> previous_;  // the state before the last converged increment
   double tPrevious_ = 0;
   std::vector<double> previousRotation_;  // the cores' rotations in that state
+  std::unique_ptr<StreamlineShift> shift_;  // built at its first use
 };
 
 }  // namespace capstan

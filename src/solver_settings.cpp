@@ -40,6 +40,13 @@ void SolverSettings::declare(ParameterList& sol) {
   sol.set("Predictor", std::string("Tangent"),
           "Tangent (linear response to the step's prescribed increment, from the previous "
           "step) | Previous (the previous step's solution with the new boundary values)");
+  sol.set("Rolling Predictor", std::string("Streamline Shift"),
+          "A turning free core's first guess: Streamline Shift (from the third step on, while the core "
+          "turns within 20% of rolling without slip: the body's shape kept standing in space while "
+          "its material turns through it, interpolated along the rings of nodes; src/streamline_shift.hpp) "
+          "| Rigid Roll (the last increment extrapolated, else the body turned with the core). "
+          "The shift: the slice 18.7 Newton iterations per step against 57.6, the 3D drive 23% fewer "
+          "(docs/numerics.md, Predictors)");
   sol.set("Line Search", std::string("Backtrack"), "Backtrack | Polynomial | Full Step (NOX line search)");
   sol.set("Volume Tolerance", 1e-10, "Pressure loop ends when max |v_e/V_e - 1| is below this");
   sol.set("Max Pressure Iterations", 100, "Most pressure-anchor updates per step");
@@ -91,6 +98,10 @@ SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterRe
   s.predictor = r.choice(sol, at, "Predictor",
                          std::vector<std::pair<const char*, Predictor>>{{"Tangent", Predictor::Tangent},
                                                                         {"Previous", Predictor::Previous}});
+  s.rollingPredictor = r.choice(sol, at, "Rolling Predictor",
+                                std::vector<std::pair<const char*, RollingPredictor>>{
+                                    {"Rigid Roll", RollingPredictor::RigidRoll},
+                                    {"Streamline Shift", RollingPredictor::StreamlineShift}});
   s.lineSearch = r.choice(sol, at, "Line Search", lineSearches);
   s.volumeTolerance = r.fraction(sol, at, "Volume Tolerance");
   s.maxPressureIterations = r.atLeast(sol, at, "Max Pressure Iterations", 1);

@@ -19,6 +19,7 @@ struct SolverSettings {
   enum class Reuse { Adaptive, None };
   enum class ToleranceMethod { Adaptive, Fixed };
   enum class Predictor { Tangent, Previous };
+  enum class RollingPredictor { StreamlineShift, RigidRoll };
   enum class LineSearch { Backtrack, Polynomial, FullStep };
   enum class PressureUpdate { SaddlePoint, Anderson };  // Auto is resolved by parse()
   enum class Schur { Auto, Laplacian, Diagonal };
@@ -35,6 +36,7 @@ struct SolverSettings {
   double newtonAbsoluteTolerance = 0;  // 0: 1e-13 c L^2 (Model)
   int maxNewtonIterations = 0;
   Predictor predictor{};
+  RollingPredictor rollingPredictor{};
   LineSearch lineSearch{};
   double volumeTolerance = 0;
   int maxPressureIterations = 0;

@@ -1,0 +1,104 @@
+#include "streamline_shift.hpp"
+
+#include <Tpetra_Import.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+#include "../kernels/rigid_core.hpp"
+#include "rigid_cores.hpp"
+
+namespace capstan {
+
+StreamlineShift::StreamlineShift(const Mesh& mesh, const RCP<const Map>& ownedDofs) : mesh_(mesh) {
+  const GO n = GO(mesh.numGlobalNodes);
+  std::vector<GO> gids(3 * n);
+  for (GO g = 0; g < 3 * n; ++g) gids[g] = g;
+  const auto invalid = Teuchos::OrdinalTraits<Tpetra::global_size_t>::invalid();
+  all_ = rcp(new Map(invalid, Teuchos::ArrayView<const GO>(gids), 0, mesh.comm));
+  import_ = rcp(new Tpetra::Import<>(ownedDofs, all_));
+  Vector X(ownedDofs), Xall(all_);
+  {
+    auto x = X.getDataNonConst();
+    for (size_t k = 0; k < mesh.numOwnedNodes; ++k)
+      for (int i = 0; i < 3; ++i) x[3 * k + i] = mesh.X[3 * k + i];
+  }
+  Xall.doImport(X, *import_, Tpetra::INSERT);
+  auto xa = Xall.getData();
+  X_.assign(xa.begin(), xa.end());
+}
+
+// Nodes grouped by their radius and axial position about the core's axis
+// (reference geometry, to 1e-9 of the largest coordinate), each ring by angle.
+const StreamlineShift::Rings& StreamlineShift::ringsOf(const RigidCore& core, size_t coreIndex) {
+  auto it = rings_.find(coreIndex);
+  if (it != rings_.end()) return it->second;
+  Rings& r = rings_[coreIndex];
+  const double* b = core.axisDirection.data();
+  double e1[3] = {1, 0, 0};
+  if (std::fabs(b[0]) > 0.9) e1[0] = 0, e1[1] = 1;
+  const double d = e1[0] * b[0] + e1[1] * b[1] + e1[2] * b[2];
+  for (int i = 0; i < 3; ++i) e1[i] -= d * b[i];
+  const double l = std::sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+  for (int i = 0; i < 3; ++i) e1[i] /= l;
+  const double e2[3] = {b[1] * e1[2] - b[2] * e1[1], b[2] * e1[0] - b[0] * e1[2], b[0] * e1[1] - b[1] * e1[0]};
+  const size_t n = X_.size() / 3;
+  double scale = 0;
+  for (double x : X_) scale = std::max(scale, std::fabs(x));
+  const double tol = 1e-9 * std::max(scale, 1e-300);
+  std::map<std::pair<long long, long long>, int> ids;
+  r.angle.resize(n);
+  r.ring.resize(n);
+  for (size_t g = 0; g < n; ++g) {
+    double R[3];
+    for (int i = 0; i < 3; ++i) R[i] = X_[3 * g + i] - core.axisPoint[i];
+    const double a = R[0] * b[0] + R[1] * b[1] + R[2] * b[2];
+    const double x1 = R[0] * e1[0] + R[1] * e1[1] + R[2] * e1[2], x2 = R[0] * e2[0] + R[1] * e2[1] + R[2] * e2[2];
+    r.angle[g] = std::atan2(x2, x1);
+    const auto key = std::make_pair(std::llround(std::sqrt(x1 * x1 + x2 * x2) / tol), std::llround(a / tol));
+    auto [pos, added] = ids.emplace(key, int(r.rings.size()));
+    if (added) r.rings.emplace_back();
+    r.ring[g] = pos->second;
+    r.rings[pos->second].push_back({r.angle[g], GO(g)});
+  }
+  for (auto& ring : r.rings) std::sort(ring.begin(), ring.end());
+  return r;
+}
+
+void StreamlineShift::apply(Vector& u, const RigidCore& core, size_t coreIndex, double dTheta, LO rotationLid) {
+  const Rings& r = ringsOf(core, coreIndex);
+  Vector uAll(all_);
+  uAll.doImport(u, *import_, Tpetra::INSERT);
+  auto ua = uAll.getData();
+  const double* b = core.axisDirection.data();
+  const size_t n = X_.size() / 3;
+  // w: each node's position about the axis, turned back by its angle.
+  std::vector<double> w(3 * n);
+  for (size_t g = 0; g < n; ++g) {
+    double p[3];
+    for (int i = 0; i < 3; ++i) p[i] = X_[3 * g + i] + ua[3 * g + i] - core.axisPoint[i] - core.translation[i];
+    kernels::rotateAboutAxis(b, -r.angle[g], p, &w[3 * g]);
+  }
+  const double twoPi = 2 * M_PI;
+  auto data = u.getDataNonConst();
+  for (size_t k = 0; k < mesh_.numOwnedNodes; ++k) {
+    const GO g = mesh_.nodeGids[k];
+    const auto& ring = r.rings[r.ring[g]];
+    // The point dTheta downstream, within [first angle, first + 2 pi).
+    double t = r.angle[g] + dTheta;
+    t -= twoPi * std::floor((t - ring.front().first) / twoPi);
+    const auto above = std::upper_bound(ring.begin(), ring.end(), std::make_pair(t, GO(-1)),
+                                        [](const auto& x, const auto& y) { return x.first < y.first; });
+    const size_t ia = size_t(above - ring.begin()) - 1, ib = (ia + 1) % ring.size();
+    const double pa = ring[ia].first, pb = ib == 0 ? ring.front().first + twoPi : ring[ib].first;
+    const double f = pb > pa ? (t - pa) / (pb - pa) : 0.0;
+    double wi[3], p[3];
+    for (int i = 0; i < 3; ++i) wi[i] = (1 - f) * w[3 * ring[ia].second + i] + f * w[3 * ring[ib].second + i];
+    kernels::rotateAboutAxis(b, t, wi, p);
+    for (int i = 0; i < 3; ++i)
+      data[3 * k + i] = core.axisPoint[i] + core.translation[i] + p[i] - mesh_.X[3 * k + i];
+  }
+  if (rotationLid >= 0) data[rotationLid] += dTheta;
+}
+
+}  // namespace capstan
