@@ -55,16 +55,18 @@ bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string
       tolIt = std::max(std::min(tol, kLaterPassReduction * f.norm2()), 1e-3 * m_.absTolerance);
     }
     const auto solveStart = Clock::now();
-    const Vector start(*m_.u, Teuchos::Copy);
+    // The solve's start, for a retry through wider friction laws (only kept
+    // where there is one).
+    const RCP<Vector> start = continuation_.applies() ? rcp(new Vector(*m_.u, Teuchos::Copy)) : Teuchos::null;
     NewtonResult r = m_.newton->solve(*m_.u, tolIt);
-    if (!r.converged && continuation_.applies()) {
+    if (!r.converged && start) {
       if (log_.on("newton"))
         log_.event("newton", format("newton failed (%s) in %d iterations: continuation in the friction "
                                     "regularisation, %d stages", r.failure.c_str(), r.iterations, continuation_.stages()),
                    eventOf("continuation").add("failed_iterations", json::number(r.iterations)));
       rec.newton += r.iterations;
       rec.linear += r.linearIterations;
-      m_.u->update(1.0, start, 0.0);
+      m_.u->update(1.0, *start, 0.0);
       r = continuation_.solve(*m_.newton, *m_.u, tolIt);
     }
     const double solveSeconds = since(solveStart);
