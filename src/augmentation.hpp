@@ -6,7 +6,6 @@
 // Anderson-accelerated, until every constraint meets its tolerance.
 #pragma once
 
-#include <memory>
 #include <string>
 
 #include "anderson.hpp"

@@ -18,14 +18,15 @@ double Predictors::firstGuess(double t0, double t, StepRecord& rec) {
   }
   // In steady rolling every increment looks like the one before (the nip has
   // moved on by one increment of the roller's turn), which the linear response
-  // from a state at rest cannot see.
-  bool extrapolated = m_.rolling && previous_ && tPrevious_ < t0 &&
-                      (shiftAlongStreamlines(t0, t) || extrapolate(t0, t, bare, f));
+  // from a state at rest cannot see: the shape shifted along the streamlines,
+  // else the last increment extrapolated.
+  bool continued = m_.rolling && previous_ && tPrevious_ < t0 &&
+                   (shiftAlongStreamlines(t0, t) || extrapolate(t0, t, bare, f));
   // From the bare state every point of a driven roller's nip slips and the
   // core's rotation has almost no stiffness: turn the body with the core first.
-  bool rolled = !extrapolated && rollWithCores(t0, t);
+  bool rolled = !continued && rollWithCores(t0, t);
   // A step that barely changes anything (steady rolling) needs no predictor.
-  if (!extrapolated && !rolled && m_.scene.solver.predictor == SolverSettings::Predictor::Tangent &&
+  if (!continued && !rolled && m_.scene.solver.predictor == SolverSettings::Predictor::Tangent &&
       bare > 1e-8 * m_.forceScale)
     tangent(t0, t, bare, rec);
   assembly.applyConstraints(*m_.u, t);
