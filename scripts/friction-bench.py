@@ -106,6 +106,8 @@ def main():
     ap.add_argument("--drive-steps", type=int, default=5)
     ap.add_argument("--replot", action="store_true", help="only draw the picture from OUT's CSV")
     ap.add_argument("--rolling-predictor", default="", help='the fast rollers\' Solver/Rolling Predictor')
+    ap.add_argument("--set", action="append", default=[], metavar="PATH=VALUE",
+                    help="a scene parameter for every run (repeatable), e.g. 'Solver/Multiplier Acceleration=Pressure'")
     a = ap.parse_args()
     a.only = a.only.split(",")
     a.predictor = [f"Solver/Rolling Predictor={a.rolling_predictor}"] if a.rolling_predictor else []
@@ -119,7 +121,7 @@ def main():
     rows = []
     print("| case | exit | steps | Newton per step (mean, max) | cuts | wall |\n|---|---|---|---|---|---|")
     for k, (label, scene, sets) in enumerate(cases(a)):
-        r = run(a.capstan, scene, os.path.join(a.out, f"run{k:02d}"), sets)
+        r = run(a.capstan, scene, os.path.join(a.out, f"run{k:02d}"), sets + a.set)
         r["case"] = label
         rows.append(r)
         print(f"| {label} | {r['rc']} | {r['steps']} | {r['newton_mean']:.1f}, {r['newton_max']} | {r['cuts']} | "

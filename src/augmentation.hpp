@@ -32,6 +32,9 @@ class AugmentationLoop {
   // moves u and the multipliers together. False if the block solve made no
   // progress (nothing is changed then).
   bool saddlePointPressureStep(double t, Vector& f, StepRecord& rec);
+  // One full Newton step from u, whose residual `start` is within the
+  // absolute tolerance, kept if it lowers the residual: one iteration.
+  NewtonResult polish(double t, double start);
   // Debugging aid: the assembled tangent against a central difference of the
   // residual along a random direction, logged (topic newton, or stdout).
   void checkTangent();

@@ -99,6 +99,9 @@ bool Predictors::shiftAlongStreamlines(double t0, double t) {
   // The cores' records are the bare state's (firstGuess evaluated it): the
   // converged translation.
   shift_->apply(*m_.u, assembly.rigidCores()[c], c, dTheta[c], assembly.ownedCoreDof(c, 3));
+  // The multipliers stand in space too: left behind, the first pass of the
+  // fast rollers and the drive started a cell's turn away from them.
+  for (const auto& e : assembly.effects()) shift_->shiftMultipliers(*e, assembly.rigidCores()[c], c, dTheta[c]);
   if (log_.on("newton"))
     log_.event("newton", format("shifted along the streamlines by %.4g", dTheta[c]),
                json::Object().add("event", json::string("streamline_shift")).add("angle", json::number(dTheta[c])));

@@ -721,7 +721,10 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
 
   const bool friction = std::any_of(sc.capstans.begin(), sc.capstans.end(),
                                     [](const CapstanSpec& c) { return c.friction.on(); });
-  sc.solver = SolverSettings::parse(P.sublist("Solver"), ParameterReader{file}, friction);
+  const bool rolling = !sc.analysis.steady() && std::any_of(sc.supports.begin(), sc.supports.end(), [](const SupportSpec& s) {
+    return s.isCore() && s.rotation == SupportSpec::Rotation::Free;
+  });
+  sc.solver = SolverSettings::parse(P.sublist("Solver"), ParameterReader{file}, friction, rolling);
   for (const auto& c : sc.capstans)
     if (c.friction.on() && sc.solver.linearSolver == SolverSettings::LinearSolver::CG)
       v.fail("Solver/Linear Solver", "CG needs a symmetric matrix; friction on capstan '" + c.name +

@@ -54,8 +54,9 @@ void SolverSettings::declare(ParameterList& sol) {
           "How the pressure loop moves the element pressure anchors after each Newton solve: "
           "Saddle Point (positions, anchors and exact contact's multipliers from one block Krylov solve, "
           "v_e = V_e and g = 0 to first order), "
-          "Anderson (pbar <- p(x), Anderson-accelerated), or Auto (Saddle Point without friction, "
-          "Anderson with it)");
+          "Anderson (pbar <- p(x), Anderson-accelerated), or Auto (Saddle Point without friction and for a "
+          "free-turning core rolling with friction in the quasi-static analysis, Anderson for other friction "
+          "scenes; docs/friction.md, \"The multiplier loop\")");
   sol.set("Pressure Step Schur", std::string("Auto"),
           "The saddle-point step's approximation of its volume rows' Schur complement: Laplacian "
           "((eps V)^-1 + 0.15 L^-1, L = G^T diag(K0)^-1 G by 30 CG iterations: it holds Q1P0's nearly "
@@ -67,12 +68,13 @@ void SolverSettings::declare(ParameterList& sol) {
   sol.set("Minimum Solve Penalty", -1.0,
           "Smallest eps1 x c used in the Newton solves: below it the condensed pressure "
           "cannot be evaluated in double precision; the pressure loop still makes v_e = V_e exact. "
-          "-1: automatic, 3e-2 with the Saddle Point pressure update, 1e-2 with Anderson");
+          "-1: automatic, 3e-2 with the Saddle Point pressure update without friction, 1e-2 otherwise");
   sol.sublist("NOX", false, "Passed to NOX unchanged, over capstan's defaults");
   sol.sublist("Stratimikos", false, "Passed to Stratimikos unchanged, over capstan's defaults");
 }
 
-SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterReader& r, bool friction) {
+SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterReader& r, bool friction,
+                                     bool rolling) {
   const std::string at = "Solver";
   SolverSettings s;
   s.linearSolver = r.choice(sol, at, "Linear Solver", linearSolvers);
@@ -105,26 +107,33 @@ SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterRe
   s.lineSearch = r.choice(sol, at, "Line Search", lineSearches);
   s.volumeTolerance = r.fraction(sol, at, "Volume Tolerance");
   s.maxPressureIterations = r.atLeast(sol, at, "Max Pressure Iterations", 1);
-  // Auto: the saddle-point step without friction; with friction the Anderson
-  // loop, whose extra passes converge the path-dependent friction multipliers
-  // further than their tolerance (docs/performance.md, "Defaults and why").
+  // Auto: the saddle-point step without friction (docs/performance.md,
+  // "Defaults and why"), and for quasi-static rolling with friction, whose
+  // multipliers move with the streamline shift (the fast rollers 51.7 Newton
+  // iterations per step against 83.5 with Anderson). Other friction scenes
+  // keep Anderson: with the step H4 fails under Arctan, and steady rolling
+  // fails (docs/friction.md, "The multiplier loop").
   enum class Update { Auto, SaddlePoint, Anderson };
   const Update update = r.choice(sol, at, "Pressure Update",
                                  std::vector<std::pair<const char*, Update>>{{"Auto", Update::Auto},
                                                                              {"Saddle Point", Update::SaddlePoint},
                                                                              {"Anderson", Update::Anderson}});
-  s.pressureUpdate = update == Update::SaddlePoint || (update == Update::Auto && !friction) ? PressureUpdate::SaddlePoint
-                                                                                            : PressureUpdate::Anderson;
+  s.pressureUpdate = update == Update::SaddlePoint || (update == Update::Auto && (!friction || rolling))
+                         ? PressureUpdate::SaddlePoint
+                         : PressureUpdate::Anderson;
   s.pressureStepSchur = r.choice(sol, at, "Pressure Step Schur",
                                  std::vector<std::pair<const char*, Schur>>{
                                      {"Auto", Schur::Auto}, {"Laplacian", Schur::Laplacian}, {"Diagonal", Schur::Diagonal}});
   s.pressureAccelerationDepth = r.atLeast(sol, at, "Pressure Acceleration Depth", 0);
   // Automatic: the fastest on G1 for each update (docs/performance.md,
-  // "Defaults and why"): 3e-2 with the saddle-point step, 1e-2 with Anderson.
+  // "Defaults and why"): 3e-2 with the saddle-point step, 1e-2 with Anderson;
+  // with friction 1e-2 (the fast rollers: 51.7 Newton iterations per step
+  // against 68.1 at 3e-2, docs/friction.md).
   s.minimumSolvePenalty = sol.get<double>("Minimum Solve Penalty");
   if (!(s.minimumSolvePenalty > 0 || s.minimumSolvePenalty == -1) || !std::isfinite(s.minimumSolvePenalty))
     r.fail("Solver/Minimum Solve Penalty", "must be > 0, or -1 (automatic), got " + Teuchos::toString(s.minimumSolvePenalty));
-  if (s.minimumSolvePenalty == -1) s.minimumSolvePenalty = s.pressureUpdate == PressureUpdate::SaddlePoint ? 3e-2 : 1e-2;
+  if (s.minimumSolvePenalty == -1)
+    s.minimumSolvePenalty = s.pressureUpdate == PressureUpdate::SaddlePoint && !friction ? 3e-2 : 1e-2;
   s.nox = sol.sublist("NOX");
   s.stratimikos = sol.sublist("Stratimikos");
   return s;
@@ -166,10 +175,10 @@ SolverSettings SolverSettings::resolved(long dofs, bool annulus, bool friction, 
   return s;
 }
 
-SolverSettings SolverSettings::defaults(bool friction) {
+SolverSettings SolverSettings::defaults(bool friction, bool rolling) {
   ParameterList list;
   declare(list);
-  return parse(list, ParameterReader{"(defaults)"}, friction);
+  return parse(list, ParameterReader{"(defaults)"}, friction, rolling);
 }
 
 }  // namespace capstan

@@ -50,14 +50,17 @@ struct SolverSettings {
   Teuchos::ParameterList nox, stratimikos;  // passed to NOX and Stratimikos over capstan's defaults
 
   static void declare(Teuchos::ParameterList& solver);
-  // `friction`: some capstan has friction (Pressure Update = Auto picks Anderson).
-  static SolverSettings parse(const Teuchos::ParameterList& solver, const ParameterReader& r, bool friction);
+  // `friction`: some capstan has friction; `rolling`: a free-turning rigid
+  // core in the quasi-static analysis (Pressure Update = Auto picks Anderson
+  // with friction unless rolling).
+  static SolverSettings parse(const Teuchos::ParameterList& solver, const ParameterReader& r, bool friction,
+                              bool rolling = false);
   // Linear Solver = Auto and Preconditioner = Auto resolved for a problem of
   // `dofs` unknowns on an annulus (or box) mesh, with or without friction
   // (docs/performance.md, "Linear solvers", has the measurements).
   SolverSettings resolved(long dofs, bool annulus, bool friction, bool steady = false) const;
   // The defaults (tests, benchmarks).
-  static SolverSettings defaults(bool friction = false);
+  static SolverSettings defaults(bool friction = false, bool rolling = false);
 
   static const std::vector<std::pair<const char*, LinearSolver>> linearSolvers;
   static const std::vector<std::pair<const char*, LineSearch>> lineSearches;

@@ -4,8 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 #include "../kernels/rigid_core.hpp"
+#include "collective.hpp"
+#include "effects/effect.hpp"
 #include "rigid_cores.hpp"
 
 namespace capstan {
@@ -99,6 +102,105 @@ void StreamlineShift::apply(Vector& u, const RigidCore& core, size_t coreIndex, 
       data[3 * k + i] = core.axisPoint[i] + core.translation[i] + p[i] - mesh_.X[3 * k + i];
   }
   if (rotationLid >= 0) data[rotationLid] += dTheta;
+}
+
+namespace {
+
+// Linear interpolation along a ring of (angle, index) sorted by angle, at
+// angle t (periodic): the two neighbours and the weight of the second.
+struct RingPoint {
+  size_t a, b;
+  double f;
+};
+template <class Ring>
+RingPoint interpolate(const Ring& ring, double t) {
+  const double twoPi = 2 * M_PI;
+  t -= twoPi * std::floor((t - ring.front().first) / twoPi);
+  const auto above = std::upper_bound(ring.begin(), ring.end(), t,
+                                      [](double x, const auto& y) { return x < y.first; });
+  const size_t ia = size_t(above - ring.begin()) - 1, ib = (ia + 1) % ring.size();
+  const double pa = ring[ia].first, pb = ib == 0 ? ring.front().first + twoPi : ring[ib].first;
+  return {ia, ib, pb > pa ? (t - pa) / (pb - pa) : 0.0};
+}
+
+}  // namespace
+
+void StreamlineShift::shiftMultipliers(Effect& effect, const RigidCore& core, size_t coreIndex, double dTheta) {
+  std::vector<int> siteNodes;
+  const int perSite = effect.multiplierSites(siteNodes);
+  if (perSite == 0) return;  // the same on every rank: it depends on the settings only
+  const Rings& r = ringsOf(core, coreIndex);
+  auto view = effect.multipliers();
+  auto values = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), view);
+  const size_t sites = siteNodes.size() / size_t(perSite);
+  int components = sites > 0 ? int(values.extent(0) / sites) : 0;
+  MPI_Comm comm = rawComm(mesh_.comm);
+  MPI_Allreduce(MPI_IN_PLACE, &components, 1, MPI_INT, MPI_MAX, comm);
+  if (components == 0) return;
+  // Per used site: its key (the rings of its nodes, sorted, padded with -1),
+  // its angle (the circular mean of its nodes' angles) and its values.
+  const size_t width = size_t(perSite) + 1 + size_t(components);
+  std::vector<double> mine;
+  std::vector<size_t> used;
+  for (size_t s = 0; s < sites; ++s) {
+    const int* nodes = &siteNodes[s * perSite];
+    if (nodes[0] < 0) continue;
+    std::vector<int> key(perSite, -1);
+    double sx = 0, sy = 0;
+    for (int a = 0; a < perSite; ++a) {
+      const GO g = mesh_.nodeGids[nodes[a]];
+      key[a] = r.ring[g];
+      sx += std::cos(r.angle[g]), sy += std::sin(r.angle[g]);
+    }
+    std::sort(key.begin(), key.end());
+    key.erase(std::unique(key.begin(), key.end()), key.end());
+    key.resize(perSite, -1);
+    for (int k : key) mine.push_back(k);
+    mine.push_back(std::atan2(sy, sx));
+    for (int c = 0; c < components; ++c) mine.push_back(values(s * components + c));
+    used.push_back(s);
+  }
+  int size = 0;
+  MPI_Comm_size(comm, &size);
+  int count = int(mine.size());
+  std::vector<int> counts(size), offsets(size, 0);
+  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
+  std::partial_sum(counts.begin(), counts.end() - 1, offsets.begin() + 1);
+  std::vector<double> all(size_t(offsets.back() + counts.back()));
+  MPI_Allgatherv(mine.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE, comm);
+  // Rings of sites, by angle; coincident sites (a node's points on its faces)
+  // averaged into one.
+  std::map<std::vector<int>, std::vector<std::pair<double, std::vector<double>>>> rings;
+  for (size_t o = 0; o < all.size(); o += width) {
+    std::vector<int> key(all.begin() + o, all.begin() + o + perSite);
+    rings[key].push_back({all[o + perSite], std::vector<double>(all.begin() + o + perSite + 1, all.begin() + o + width)});
+  }
+  for (auto& [key, ring] : rings) {
+    std::sort(ring.begin(), ring.end());
+    std::vector<std::pair<double, std::vector<double>>> merged;
+    std::vector<int> n;
+    for (auto& site : ring) {
+      if (!merged.empty() && std::fabs(site.first - merged.back().first) < 1e-12) {
+        for (int c = 0; c < components; ++c) merged.back().second[c] += site.second[c];
+        ++n.back();
+        continue;
+      }
+      merged.push_back(site);
+      n.push_back(1);
+    }
+    for (size_t i = 0; i < merged.size(); ++i)
+      for (double& v : merged[i].second) v /= n[i];
+    ring = std::move(merged);
+  }
+  for (size_t i = 0; i < used.size(); ++i) {
+    const double* rec = &mine[i * width];
+    const auto& ring = rings.at(std::vector<int>(rec, rec + perSite));
+    const RingPoint p = interpolate(ring, rec[perSite] + dTheta);
+    for (int c = 0; c < components; ++c)
+      values(used[i] * components + c) = (1 - p.f) * ring[p.a].second[c] + p.f * ring[p.b].second[c];
+  }
+  Kokkos::deep_copy(view, values);
+  effect.projectMultipliers();
 }
 
 }  // namespace capstan

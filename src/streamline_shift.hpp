@@ -12,6 +12,12 @@
 // roll (Predictors::rollWithCores) instead carries the flattening round with
 // the material, which Newton must then undo.
 //
+// The multipliers (pressure anchors, contact pressures, stick tractions) stand
+// in space as well, so they move the same way (shiftMultipliers): each site's
+// value becomes the one dTheta downstream along its ring of sites (the sites
+// on the same rings of nodes), linear in angle. Tractions are spatial vectors
+// and are not turned.
+//
 // Every rank holds every node's reference position and, per shift, every
 // node's displacement (a replicated import): O(nodes) memory per rank.
 #pragma once
@@ -25,6 +31,7 @@ namespace capstan {
 
 struct Mesh;
 struct RigidCore;
+class Effect;
 
 class StreamlineShift {
  public:
@@ -33,6 +40,9 @@ class StreamlineShift {
   // `core` (as u puts it: its translation) turning by dTheta; rotationLid: the
   // local id of its rotation unknown in u, or -1 on ranks that do not own it.
   void apply(Vector& u, const RigidCore& core, size_t coreIndex, double dTheta, LO rotationLid);
+  // An effect's multipliers moved likewise (Effect::multiplierSites); nothing
+  // for effects without sites. Collective.
+  void shiftMultipliers(Effect& effect, const RigidCore& core, size_t coreIndex, double dTheta);
 
  private:
   struct Rings {

@@ -12,6 +12,8 @@
 #include "errors.hpp"
 #include "roller_scene.hpp"
 #include "scene.hpp"
+#include "streamline_shift.hpp"
+#include "effects/effect.hpp"
 
 using namespace capstan;
 
@@ -157,4 +159,69 @@ TEST(RigidCore, TorqueRampsToItsOwnTime) {
   EXPECT_DOUBLE_EQ(c.loadFactor(4.0), 1.0);
   EXPECT_DOUBLE_EQ(c.torqueFactor(4.0), 0.8);
   EXPECT_DOUBLE_EQ(c.torqueFactor(6.0), 1.0);
+}
+
+// The streamline shift moves the multipliers with the material: each site's
+// value becomes the one dTheta downstream along its ring, linear in angle
+// (src/streamline_shift.hpp). Pressure anchors (per element), exact contact
+// pressures and stick tractions (per nodal point) carry smooth fields of the
+// angle about the core's axis; a shift by one cell must hand each site its
+// downstream neighbour's value exactly, and a shift by part of a cell the
+// field's value there within linear interpolation's error.
+TEST(StreamlineShift, MovesMultipliersAlongTheRings) {
+  const int cells = 24;
+  const Scene scene = parseScene(kScene, "rigid-core-test.xml",
+                                 {"Mesh/Cells={2, 24, 2}", "Supports/core/Axis Point={0, 0, 0}",
+                                  "Supports/core/Axis Direction={0, 0, 1}",
+                                  "Capstans/capstan/Contact/Method=Augmented Lagrangian",
+                                  "Capstans/capstan/Friction/Law=Coulomb"},
+                                 "");
+  const auto& m = scene.mesh;
+  AnnulusGenerator gen(m.center, m.innerRadius, m.outerRadius, m.length, m.cells);
+  Mesh mesh = distributeMesh(gen, Tpetra::getDefaultComm());
+  Assembly assembly(mesh, scene);
+  StreamlineShift shift(mesh, assembly.dofMap());
+  const auto& core = assembly.rigidCores().at(0);
+  auto angleOf = [&](const int* nodes, int count) {
+    double sx = 0, sy = 0;
+    for (int a = 0; a < count; ++a) {
+      const double th = std::atan2(mesh.X[3 * nodes[a] + 1], mesh.X[3 * nodes[a]]);
+      sx += std::cos(th), sy += std::sin(th);
+    }
+    return std::atan2(sy, sx);
+  };
+  // A smooth positive field (contact pressures are projected onto >= 0).
+  auto field = [](double th, int c) { return 2 + std::cos(th + c) + 0.5 * std::sin(2 * th); };
+  int shifted = 0;
+  for (const auto& e : assembly.effects()) {
+    std::vector<int> nodes;
+    const int perSite = e->multiplierSites(nodes);
+    if (perSite == 0) continue;
+    ++shifted;
+    const size_t sites = nodes.size() / perSite;
+    auto view = e->multipliers();
+    const int components = sites ? int(view.extent(0) / sites) : 1;
+    for (double dTheta : {2 * M_PI / cells, 0.1}) {
+      auto h = Kokkos::create_mirror_view(view);
+      for (size_t s = 0; s < sites; ++s)
+        for (int c = 0; c < components; ++c)
+          h(s * components + c) = nodes[s * perSite] < 0 ? 0.0 : field(angleOf(&nodes[s * perSite], perSite), c);
+      Kokkos::deep_copy(view, h);
+      shift.shiftMultipliers(*e, core, 0, dTheta);
+      Kokkos::deep_copy(h, view);
+      // Linear interpolation's error bound, h^2/8 max|f''| (f'' <= 3).
+      const double tol = dTheta < 0.2 ? std::pow(2 * M_PI / cells, 2) / 8 * 3 : 1e-12;
+      double worst = 0;
+      for (size_t s = 0; s < sites; ++s) {
+        if (nodes[s * perSite] < 0) continue;
+        const double th = angleOf(&nodes[s * perSite], perSite) + dTheta;
+        for (int c = 0; c < components; ++c) worst = std::max(worst, std::fabs(h(s * components + c) - field(th, c)));
+      }
+      EXPECT_LT(worst, tol) << e->name() << " shifted by " << dTheta;
+      if (dTheta < 0.2) {
+        EXPECT_GT(worst, 1e-4) << "the field is not linear: interpolation must show";
+      }
+    }
+  }
+  EXPECT_EQ(shifted, 3);  // bricks, contact, friction
 }

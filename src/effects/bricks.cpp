@@ -133,4 +133,10 @@ void BrickEffect::centroidStress(const NodalVectors& x, Matrix& stress,
       });
 }
 
+int BrickEffect::multiplierSites(std::vector<int>& nodes) const {
+  auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), nodes_);
+  nodes.assign(h.data(), h.data() + h.size());
+  return 8;
+}
+
 }  // namespace capstan

@@ -27,6 +27,7 @@ class BrickEffect : public Effect {
 
   // Pressure anchors: G(pbar) = p(x); violation max |v/V - 1|.
   Kokkos::View<double*> multipliers() override { return pressureAnchor; }
+  int multiplierSites(std::vector<int>& nodes) const override;  // an element's 8 nodes
   void multiplierMap(const Kokkos::View<double*>& next) const override;
   double constraintViolation() const override;
   double constraintTolerance() const override { return volumeTolerance_; }

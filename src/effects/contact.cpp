@@ -132,6 +132,15 @@ void ContactEffect::projectMultipliers() {
       KOKKOS_LAMBDA(int i) { lambda(i) = lambda(i) > 0 ? lambda(i) : 0.0; });
 }
 
+int ContactEffect::multiplierSites(std::vector<int>& nodes) const {
+  if (!augmented() || rule() != kernels::FaceRule::Nodal) return 0;
+  auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), nodes_);
+  nodes.assign(h.extent(0) * kernels::kMaxFacePoints, -1);
+  for (size_t f = 0; f < h.extent(0); ++f)
+    for (int q = 0; q < 4; ++q) nodes[f * kernels::kMaxFacePoints + q] = h(f, q);  // the rule's point q: corner q
+  return 1;
+}
+
 void ContactEffect::constraintRows(const NodalVectors&, ConstraintRows& rows) const {
   rows.clear();
   if (!augmented() || settings().smoothing > 0) {

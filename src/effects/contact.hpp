@@ -30,6 +30,8 @@ class ContactEffect : public Effect {
   }
   void multiplierMap(const Kokkos::View<double*>& next) const override;
   void projectMultipliers() override;
+  // Exact contact with the nodal rule: each point's node.
+  int multiplierSites(std::vector<int>& nodes) const override;
   // Plain Uzawa: each update removes most of the penetration already (the
   // penalty is much stiffer than the body), and mixing across the kink of
   // max(0, .) where points enter or leave contact made the loop wander.

@@ -165,6 +165,11 @@ class Effect {
   virtual bool accelerated() const { return true; }
   // Brings mixed multipliers back into their admissible set (e.g. lambda >= 0).
   virtual void projectMultipliers() {}
+  // Where the multipliers sit, for moving them with the material (the
+  // streamline shift, src/streamline_shift.hpp): per site, the returned count
+  // of overlapped node ids (-1: an unused site); multipliers() holds sites x
+  // components values. 0: these multipliers do not move so.
+  virtual int multiplierSites(std::vector<int>& /*nodes*/) const { return 0; }
   // This rank's rows for the saddle-point step, at positions x (the last
   // evaluation's); none by default (a plain multiplier update).
   virtual void constraintRows(const NodalVectors& /*x*/, ConstraintRows& rows) const { rows.clear(); }

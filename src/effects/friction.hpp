@@ -42,6 +42,10 @@ class FrictionEffect : public Effect {
   }
   void multiplierMap(const Kokkos::View<double*>& next) const override;
   bool accelerated() const override { return false; }
+  // The stick multipliers sit at the contact's points.
+  int multiplierSites(std::vector<int>& nodes) const override {
+    return augmented() ? contact_.multiplierSites(nodes) : 0;
+  }
   double constraintViolation() const override;
   double constraintTolerance() const override { return contact_.constraintTolerance(); }
   std::string constraintName() const override { return name() + " stick slip"; }

@@ -38,6 +38,7 @@ class SteadyFrictionEffect : public FrictionEffect {
   void commit(const NodalVectors&) override {}
   bool augmented() const override { return settings_.law == FrictionSettings::Law::Coulomb; }
   bool accelerated() const override { return true; }
+  int multiplierSites(std::vector<int>&) const override { return 0; }  // the mesh stands still: no shift
   // Steady rolling's start: friction off (a frictionless footprint first).
   void setEnabled(bool on) { enabled_ = on; }
   // The flow's angular velocity scale: the no-slip estimate about +z.
