@@ -13,6 +13,27 @@
 
 namespace capstan {
 
+namespace {
+
+// Linear interpolation along a ring of (angle, index) sorted by angle, at
+// angle t (periodic): the two neighbours and the weight of the second.
+struct RingPoint {
+  size_t a, b;
+  double f;
+};
+template <class Ring>
+RingPoint interpolate(const Ring& ring, double t) {
+  const double twoPi = 2 * M_PI;
+  t -= twoPi * std::floor((t - ring.front().first) / twoPi);
+  const auto above = std::upper_bound(ring.begin(), ring.end(), t,
+                                      [](double x, const auto& y) { return x < y.first; });
+  const size_t ia = size_t(above - ring.begin()) - 1, ib = (ia + 1) % ring.size();
+  const double pa = ring[ia].first, pb = ib == 0 ? ring.front().first + twoPi : ring[ib].first;
+  return {ia, ib, pb > pa ? (t - pa) / (pb - pa) : 0.0};
+}
+
+}  // namespace
+
 StreamlineShift::StreamlineShift(const Mesh& mesh, const RCP<const Map>& ownedDofs) : mesh_(mesh) {
   const GO n = GO(mesh.numGlobalNodes);
   std::vector<GO> gids(3 * n);
@@ -82,21 +103,15 @@ void StreamlineShift::apply(Vector& u, const RigidCore& core, size_t coreIndex, 
     for (int i = 0; i < 3; ++i) p[i] = X_[3 * g + i] + ua[3 * g + i] - core.axisPoint[i] - core.translation[i];
     kernels::rotateAboutAxis(b, -r.angle[g], p, &w[3 * g]);
   }
-  const double twoPi = 2 * M_PI;
   auto data = u.getDataNonConst();
   for (size_t k = 0; k < mesh_.numOwnedNodes; ++k) {
     const GO g = mesh_.nodeGids[k];
     const auto& ring = r.rings[r.ring[g]];
-    // The point dTheta downstream, within [first angle, first + 2 pi).
-    double t = r.angle[g] + dTheta;
-    t -= twoPi * std::floor((t - ring.front().first) / twoPi);
-    const auto above = std::upper_bound(ring.begin(), ring.end(), std::make_pair(t, GO(-1)),
-                                        [](const auto& x, const auto& y) { return x.first < y.first; });
-    const size_t ia = size_t(above - ring.begin()) - 1, ib = (ia + 1) % ring.size();
-    const double pa = ring[ia].first, pb = ib == 0 ? ring.front().first + twoPi : ring[ib].first;
-    const double f = pb > pa ? (t - pa) / (pb - pa) : 0.0;
+    const double t = r.angle[g] + dTheta;  // the point dTheta downstream
+    const RingPoint q = interpolate(ring, t);
+    const GO ga = ring[q.a].second, gb = ring[q.b].second;
     double wi[3], p[3];
-    for (int i = 0; i < 3; ++i) wi[i] = (1 - f) * w[3 * ring[ia].second + i] + f * w[3 * ring[ib].second + i];
+    for (int i = 0; i < 3; ++i) wi[i] = (1 - q.f) * w[3 * ga + i] + q.f * w[3 * gb + i];
     kernels::rotateAboutAxis(b, t, wi, p);
     for (int i = 0; i < 3; ++i)
       data[3 * k + i] = core.axisPoint[i] + core.translation[i] + p[i] - mesh_.X[3 * k + i];
@@ -104,26 +119,6 @@ void StreamlineShift::apply(Vector& u, const RigidCore& core, size_t coreIndex, 
   if (rotationLid >= 0) data[rotationLid] += dTheta;
 }
 
-namespace {
-
-// Linear interpolation along a ring of (angle, index) sorted by angle, at
-// angle t (periodic): the two neighbours and the weight of the second.
-struct RingPoint {
-  size_t a, b;
-  double f;
-};
-template <class Ring>
-RingPoint interpolate(const Ring& ring, double t) {
-  const double twoPi = 2 * M_PI;
-  t -= twoPi * std::floor((t - ring.front().first) / twoPi);
-  const auto above = std::upper_bound(ring.begin(), ring.end(), t,
-                                      [](double x, const auto& y) { return x < y.first; });
-  const size_t ia = size_t(above - ring.begin()) - 1, ib = (ia + 1) % ring.size();
-  const double pa = ring[ia].first, pb = ib == 0 ? ring.front().first + twoPi : ring[ib].first;
-  return {ia, ib, pb > pa ? (t - pa) / (pb - pa) : 0.0};
-}
-
-}  // namespace
 
 void StreamlineShift::shiftMultipliers(Effect& effect, const RigidCore& core, size_t coreIndex, double dTheta) {
   std::vector<int> siteNodes;
