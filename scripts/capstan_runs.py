@@ -1,9 +1,10 @@
-"""Running capstan from the study scripts (scaling.py, speedup.py): the command
-line of one run, the run itself, and the totals of its summary.json."""
+"""Running capstan from the study scripts (scaling.py, speedup.py, the benches):
+the command line of one run, the run itself, and the totals of its summary.json."""
 import json
 import os
 import subprocess
 import sys
+import time
 
 ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 CAPSTAN = os.path.join(ROOT, "build", "capstan")
@@ -28,6 +29,23 @@ def command(capstan, scene, out, cells, ranks, sets=(), steps=0):
     if ranks > 1:
         cmd = ["mpiexec", "--oversubscribe", "-n", str(ranks)] + cmd
     return cmd
+
+
+def run_scene(capstan, scene, out, sets=()):
+    """One quiet `capstan run` of inputs/SCENE with no field output, timed:
+    (exit status, wall seconds, summary.json or None)."""
+    cmd = [capstan, "run", os.path.join(ROOT, "inputs", scene), "--output", out, "--quiet",
+           "--set", "Output/Write Fields=false"]
+    for s in sets:
+        cmd += ["--set", s]
+    t0 = time.perf_counter()
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    wall = time.perf_counter() - t0
+    path = os.path.join(out, "summary.json")
+    if not os.path.isfile(path):
+        return p.returncode, wall, None
+    with open(path) as f:
+        return p.returncode, wall, json.load(f)
 
 
 def summary(out, cmd, tag, script):

@@ -22,31 +22,19 @@ Run it with /usr/bin/python3 (Debian's, which has matplotlib).
 """
 import argparse
 import csv
-import json
 import os
-import subprocess
-import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+from capstan_runs import ROOT, run_scene
+
 AL = "Capstans/capstan/Contact/Method=Augmented Lagrangian"
 F = "Capstans/capstan/Friction/"
 
 
 def run(capstan, scene, out, sets):
-    cmd = [capstan, "run", os.path.join(ROOT, "inputs", scene), "--output", out, "--quiet",
-           "--set", "Output/Write Fields=false"]
-    for s in sets:
-        cmd += ["--set", s]
-    t0 = time.perf_counter()
-    p = subprocess.run(cmd, capture_output=True, text=True)
-    wall = time.perf_counter() - t0
-    steps = []
-    path = os.path.join(out, "summary.json")
-    if os.path.isfile(path):
-        with open(path) as f:
-            steps = json.load(f)["steps"]
+    rc, wall, summary = run_scene(capstan, scene, out, sets)
+    steps = summary["steps"] if summary else []
     newton = [s["newton_iterations"] for s in steps]
-    return {"rc": p.returncode, "wall": wall, "steps": len(steps),
+    return {"rc": rc, "wall": wall, "steps": len(steps),
             "newton_mean": sum(newton) / len(newton) if newton else 0.0,
             "newton_max": max(newton) if newton else 0, "cuts": sum(s["cutbacks"] for s in steps)}
 

@@ -14,26 +14,10 @@ ratio of the transient wall time to the steady one.
   scripts/steady-bench.py [--capstan build/capstan] [--transient] [--steps 20] [--out out/steady-bench]
 """
 import argparse
-import json
 import os
-import subprocess
 import sys
-import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-
-
-def run(capstan, scene, out, sets=()):
-    cmd = [capstan, "run", os.path.join(ROOT, "inputs", scene), "--output", out, "--quiet",
-           "--set", "Output/Write Fields=false"]
-    for s in sets:
-        cmd += ["--set", s]
-    t0 = time.perf_counter()
-    p = subprocess.run(cmd, capture_output=True, text=True)
-    wall = time.perf_counter() - t0
-    with open(os.path.join(out, "summary.json")) as f:
-        s = json.load(f)
-    return p.returncode, wall, s
+from capstan_runs import ROOT, run_scene
 
 
 def describe(label, rc, wall, s):
@@ -43,7 +27,7 @@ def describe(label, rc, wall, s):
     ratios = [st["supports"]["core"].get("speed_ratio", float("nan")) for st in steps]
     print(f"{label}: exit {rc}, {wall:.1f} s wall, {len(steps)} steps, cuts {cuts}")
     print(f"    Newton per step: {newton}")
-    print(f"    speed ratio: " + ", ".join(f"{r:.5f}" for r in ratios))
+    print("    speed ratio: " + ", ".join(f"{r:.5f}" for r in ratios))
     if len(ratios) > 2:
         half = ratios[len(ratios) // 2:]
         print(f"    mean speed ratio over the second half: {sum(half) / len(half):.5f}")
@@ -57,15 +41,15 @@ def main():
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "steady-bench"))
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
-    rc, steady_wall, s = run(a.capstan, "pinch-roller-steady.xml", os.path.join(a.out, "drive-steady"))
+    rc, steady_wall, s = run_scene(a.capstan, "pinch-roller-steady.xml", os.path.join(a.out, "drive-steady"))
     describe("3D drive, steady state", rc, steady_wall, s)
-    rc, wall, s = run(a.capstan, "pinch-roller-steady.xml", os.path.join(a.out, "drive-sweep"),
+    rc, wall, s = run_scene(a.capstan, "pinch-roller-steady.xml", os.path.join(a.out, "drive-sweep"),
                       ["Supports/core/Torque=18", "Supports/core/Torque Ramp Time=0.010", "Time/Steps=10"])
     describe("3D drive, 10-torque brake sweep", rc, wall, s)
-    rc, wall, s = run(a.capstan, "pinch-roller-braked-steady.xml", os.path.join(a.out, "slice-sweep"))
+    rc, wall, s = run_scene(a.capstan, "pinch-roller-braked-steady.xml", os.path.join(a.out, "slice-sweep"))
     describe("slice, 11-torque brake sweep", rc, wall, s)
     if a.transient:
-        rc, wall, s = run(a.capstan, "pinch-roller.xml", os.path.join(a.out, "drive-transient"),
+        rc, wall, s = run_scene(a.capstan, "pinch-roller.xml", os.path.join(a.out, "drive-transient"),
                           [f"Time/Steps={a.steps}"])
         describe(f"3D drive, quasi-static, {a.steps} steps", rc, wall, s)
         print(f"transient / steady wall time: {wall / steady_wall:.1f}")
