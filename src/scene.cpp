@@ -721,9 +721,11 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
 
   const bool friction = std::any_of(sc.capstans.begin(), sc.capstans.end(),
                                     [](const CapstanSpec& c) { return c.friction.on(); });
-  const bool rolling = !sc.analysis.steady() && std::any_of(sc.supports.begin(), sc.supports.end(), [](const SupportSpec& s) {
-    return s.isCore() && s.rotation == SupportSpec::Rotation::Free;
-  });
+  // Quasi-static rolling: a free-turning rigid core (Model::rolling at run time).
+  const bool rolling = !sc.analysis.steady() &&
+                       std::any_of(sc.supports.begin(), sc.supports.end(), [](const SupportSpec& s) {
+                         return s.isCore() && s.rotation == SupportSpec::Rotation::Free;
+                       });
   sc.solver = SolverSettings::parse(P.sublist("Solver"), ParameterReader{file}, friction, rolling);
   for (const auto& c : sc.capstans)
     if (c.friction.on() && sc.solver.linearSolver == SolverSettings::LinearSolver::CG)

@@ -32,6 +32,40 @@ RingPoint interpolate(const Ring& ring, double t) {
   return {ia, ib, pb > pa ? (t - pa) / (pb - pa) : 0.0};
 }
 
+// Every rank's records (doubles), concatenated in rank order on every rank.
+std::vector<double> gatherAll(const std::vector<double>& mine, MPI_Comm comm) {
+  int size = 0;
+  MPI_Comm_size(comm, &size);
+  int count = int(mine.size());
+  std::vector<int> counts(size), offsets(size, 0);
+  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
+  std::partial_sum(counts.begin(), counts.end() - 1, offsets.begin() + 1);
+  std::vector<double> all(size_t(offsets.back() + counts.back()));
+  MPI_Allgatherv(mine.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE, comm);
+  return all;
+}
+
+// A ring of sites (angle, values) sorted by angle, coincident sites (a
+// node's points on its faces) averaged into one.
+using SiteRing = std::vector<std::pair<double, std::vector<double>>>;
+SiteRing mergeCoincident(SiteRing ring) {
+  std::sort(ring.begin(), ring.end());
+  SiteRing merged;
+  std::vector<int> n;
+  for (auto& site : ring) {
+    if (!merged.empty() && std::fabs(site.first - merged.back().first) < 1e-12) {
+      for (size_t c = 0; c < site.second.size(); ++c) merged.back().second[c] += site.second[c];
+      ++n.back();
+      continue;
+    }
+    merged.push_back(std::move(site));
+    n.push_back(1);
+  }
+  for (size_t i = 0; i < merged.size(); ++i)
+    for (double& v : merged[i].second) v /= n[i];
+  return merged;
+}
+
 }  // namespace
 
 StreamlineShift::StreamlineShift(const Mesh& mesh, const RCP<const Map>& ownedDofs) : mesh_(mesh) {
@@ -119,7 +153,6 @@ void StreamlineShift::apply(Vector& u, const RigidCore& core, size_t coreIndex, 
   if (rotationLid >= 0) data[rotationLid] += dTheta;
 }
 
-
 void StreamlineShift::shiftMultipliers(Effect& effect, const RigidCore& core, size_t coreIndex, double dTheta) {
   std::vector<int> siteNodes;
   const int perSite = effect.multiplierSites(siteNodes);
@@ -155,38 +188,13 @@ void StreamlineShift::shiftMultipliers(Effect& effect, const RigidCore& core, si
     for (int c = 0; c < components; ++c) mine.push_back(values(s * components + c));
     used.push_back(s);
   }
-  int size = 0;
-  MPI_Comm_size(comm, &size);
-  int count = int(mine.size());
-  std::vector<int> counts(size), offsets(size, 0);
-  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
-  std::partial_sum(counts.begin(), counts.end() - 1, offsets.begin() + 1);
-  std::vector<double> all(size_t(offsets.back() + counts.back()));
-  MPI_Allgatherv(mine.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE, comm);
-  // Rings of sites, by angle; coincident sites (a node's points on its faces)
-  // averaged into one.
-  std::map<std::vector<int>, std::vector<std::pair<double, std::vector<double>>>> rings;
+  const std::vector<double> all = gatherAll(mine, comm);
+  std::map<std::vector<int>, SiteRing> rings;
   for (size_t o = 0; o < all.size(); o += width) {
     std::vector<int> key(all.begin() + o, all.begin() + o + perSite);
     rings[key].push_back({all[o + perSite], std::vector<double>(all.begin() + o + perSite + 1, all.begin() + o + width)});
   }
-  for (auto& [key, ring] : rings) {
-    std::sort(ring.begin(), ring.end());
-    std::vector<std::pair<double, std::vector<double>>> merged;
-    std::vector<int> n;
-    for (auto& site : ring) {
-      if (!merged.empty() && std::fabs(site.first - merged.back().first) < 1e-12) {
-        for (int c = 0; c < components; ++c) merged.back().second[c] += site.second[c];
-        ++n.back();
-        continue;
-      }
-      merged.push_back(site);
-      n.push_back(1);
-    }
-    for (size_t i = 0; i < merged.size(); ++i)
-      for (double& v : merged[i].second) v /= n[i];
-    ring = std::move(merged);
-  }
+  for (auto& entry : rings) entry.second = mergeCoincident(std::move(entry.second));
   for (size_t i = 0; i < used.size(); ++i) {
     const double* rec = &mine[i * width];
     const auto& ring = rings.at(std::vector<int>(rec, rec + perSite));

@@ -136,8 +136,9 @@ int ContactEffect::multiplierSites(std::vector<int>& nodes) const {
   if (!augmented() || rule() != kernels::FaceRule::Nodal) return 0;
   auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), nodes_);
   nodes.assign(h.extent(0) * kernels::kMaxFacePoints, -1);
+  const int nq = kernels::facePointCount(rule());
   for (size_t f = 0; f < h.extent(0); ++f)
-    for (int q = 0; q < 4; ++q) nodes[f * kernels::kMaxFacePoints + q] = h(f, q);  // the rule's point q: corner q
+    for (int q = 0; q < nq; ++q) nodes[f * kernels::kMaxFacePoints + q] = h(f, q);  // the nodal rule's point q: corner q
   return 1;
 }
 
