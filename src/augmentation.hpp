@@ -31,7 +31,8 @@ class AugmentationLoop {
   // The saddle-point step at the converged state (src/pressure_step.hpp):
   // moves u and the multipliers together. False if the block solve made no
   // progress (nothing is changed then).
-  bool saddlePointPressureStep(double t, Vector& f, StepRecord& rec);
+  // volumeMet: the volumes already meet their tolerance (a step for other rows).
+  bool saddlePointPressureStep(double t, Vector& f, bool volumeMet, StepRecord& rec);
   // One full Newton step from u, whose residual `start` is within the
   // absolute tolerance, kept if it lowers the residual: one iteration.
   NewtonResult polish(double t, double start);

@@ -375,7 +375,13 @@ PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv
     auto h = Kokkos::create_mirror_view(dmu[i]);
     Kokkos::deep_copy(h, 0.0);
     const ConstraintRows& r = effectRows_[i];
-    for (size_t k = 0; k < r.size(); ++k, ++j) h(r.multiplier[k]) = xc[j];
+    for (size_t k = 0; k < r.size(); ++k, ++j) {
+      if (r.direction.empty()) {
+        h(r.multiplier[k]) = xc[j];
+        continue;
+      }
+      for (int i = 0; i < 3; ++i) h(r.multiplier[k] + i) += xc[j] * r.direction[3 * k + i];
+    }
     Kokkos::deep_copy(dmu[i], h);
   }
   seconds_ += timer.seconds();

@@ -56,7 +56,7 @@ void SolverSettings::declare(ParameterList& sol) {
   sol.set("Max Pressure Iterations", 100, "Most pressure-anchor updates per step");
   sol.set("Pressure Update", std::string("Auto"),
           "How the pressure loop moves the element pressure anchors after each Newton solve: "
-          "Saddle Point (positions, anchors and exact contact's multipliers from one block Krylov solve, "
+          "Saddle Point (positions, anchors, exact contact's multipliers and Coulomb's stick tractions from one block Krylov solve, "
           "v_e = V_e and g = 0 to first order), "
           "Anderson (pbar <- p(x), Anderson-accelerated), or Auto (Saddle Point without friction and for a "
           "free-turning core rolling with friction in the quasi-static analysis, Anderson for other friction "

@@ -116,8 +116,15 @@ struct ConstraintRows {
   // c_j's unit for the step's stop rule (|c_j| / scale_j against a relative
   // tolerance), or 0: the stop rule does not look at row j.
   std::vector<double> scale;
+  // Empty: mu_j is one multiplier. Otherwise 3 per row: mu_j is the component
+  // of a vector multiplier (multipliers()[multiplier_j + i], i < 3) along this
+  // unit direction (a stick traction along a tangent of the capstan).
+  std::vector<double> direction;
   size_t size() const { return entity.size(); }
-  void clear() { entity.clear(), multiplier.clear(), force.clear(), diagonal.clear(), value.clear(), schur.clear(), scale.clear(); }
+  void clear() {
+    entity.clear(), multiplier.clear(), force.clear(), diagonal.clear(), value.clear(), schur.clear(), scale.clear();
+    direction.clear();
+  }
 };
 
 struct StepRecord;
@@ -173,6 +180,9 @@ class Effect {
   // This rank's rows for the saddle-point step, at positions x (the last
   // evaluation's); none by default (a plain multiplier update).
   virtual void constraintRows(const NodalVectors& /*x*/, ConstraintRows& rows) const { rows.clear(); }
+  // Whether this effect's violation alone calls for the saddle-point step
+  // (it has rows there); otherwise the step is taken for the volumes only.
+  virtual bool stepsForItself() const { return false; }
   // Largest violation of the constraint on this rank at the last evaluation,
   // and the tolerance it must meet (same units).
   virtual double constraintViolation() const { return 0; }

@@ -146,6 +146,46 @@ void FrictionEffect::multiplierMap(const Kokkos::View<double*>& next) const {
       });
 }
 
+void FrictionEffect::constraintRows(const NodalVectors&, ConstraintRows& rows) const {
+  rows.clear();
+  rows.gradient = Matrix();
+  if (!augmented() || parameters_.smoothing > 0) return;
+  // On the host: the points of the nip only.
+  auto pts = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), points_);
+  auto lambdaT = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), tangentialMultipliers_);
+  const auto rule = contact_.rule();
+  const int nq = kernels::facePointCount(rule);
+  const auto b = contact_.axisDirection();
+  const double epsT = parameters_.tangentPenalty;
+  std::vector<double> grad;
+  for (size_t f = 0; f < pts.extent(0); ++f)
+    for (int q = 0; q < nq; ++q) {
+      if (int(pts(f, q, kState)) != 1) continue;
+      const int m = (int(f) * kernels::kMaxFacePoints + q) * 3;
+      double xi, eta, w, N[4], dN[4][2];
+      kernels::facePoint(rule, q, xi, eta, w);
+      kernels::quadShape(xi, eta, N, dN);
+      const double* e = &pts(f, q, kFE);
+      const double tangents[2][3] = {{b[1] * e[2] - b[2] * e[1], b[2] * e[0] - b[0] * e[2], b[0] * e[1] - b[1] * e[0]},
+                                     {b[0], b[1], b[2]}};
+      for (const auto& tau : tangents) {
+        // The slip along tau, from the stick traction t = P_t lambda_T + du_t / eps_t.
+        double slip = 0;
+        for (int i = 0; i < 3; ++i) slip += epsT * tau[i] * (pts(f, q, kTraction + i) - lambdaT(m + i));
+        for (int a = 0; a < 4; ++a)
+          for (int i = 0; i < 3; ++i) grad.push_back(-N[a] * tau[i]);  // d(tau . du_t) / dx_a
+        rows.entity.push_back(int(f)), rows.multiplier.push_back(m);
+        rows.force.push_back(pts(f, q, kFWeight)), rows.diagonal.push_back(0.0);
+        rows.value.push_back(slip), rows.schur.push_back(-epsT), rows.scale.push_back(0.0);
+        rows.direction.insert(rows.direction.end(), tau, tau + 3);
+      }
+    }
+  rows.gradient = Matrix("stick dc/dx", rows.size(), 12);
+  auto h = Kokkos::create_mirror_view(rows.gradient);
+  for (size_t k = 0; k < grad.size(); ++k) h.data()[k] = grad[k];
+  Kokkos::deep_copy(rows.gradient, h);
+}
+
 double FrictionEffect::constraintViolation() const {
   if (!augmented()) return 0;
   auto pts = points_;

@@ -39,6 +39,12 @@ class SteadyFrictionEffect : public FrictionEffect {
   bool augmented() const override { return settings_.law == FrictionSettings::Law::Coulomb; }
   bool accelerated() const override { return true; }
   int multiplierSites(std::vector<int>&) const override { return 0; }  // the mesh stands still: no shift
+  // Its entities span the upstream nodes too: the stick rows are not built for them.
+  void constraintRows(const NodalVectors&, ConstraintRows& rows) const override {
+    rows.clear();
+    rows.gradient = Matrix();
+  }
+  bool stepsForItself() const override { return false; }
   // Steady rolling's start: friction off (a frictionless footprint first).
   void setEnabled(bool on) { enabled_ = on; }
   // The flow's angular velocity scale: the no-slip estimate about +z.

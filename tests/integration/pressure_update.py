@@ -1,15 +1,18 @@
 #!/usr/bin/env python3
 """The two pressure updates reach the same converged state.
 
-Solver/Pressure Update = Saddle Point (positions and pressure anchors from one
-block Krylov solve per pass; Auto's choice without friction) and Anderson
-(pbar <- p(x), Anderson-accelerated; Auto's choice with friction) are two
-routes to the same fixed point, v_e = V_e with the contact and friction
-multipliers converged. On
+Solver/Pressure Update = Saddle Point (positions, pressure anchors, exact
+contact's multipliers and Coulomb's stick tractions from one block Krylov solve
+per pass; Auto's choice without friction and for quasi-static rolling with
+friction) and Anderson (pbar <- p(x), Anderson-accelerated; Auto's choice for
+other friction scenes) are two routes to the same fixed point,
+v_e = V_e with the contact and friction multipliers converged. On
 
   * seed/g1.xml refined 2x (frictionless indentation, augmented contact),
-    GMRES + MueLu, and
-  * seed/h1.xml (rolling with tanh friction on a soft foundation),
+    GMRES + MueLu,
+  * seed/h1.xml (rolling with tanh friction on a soft foundation), and
+  * seed/stick-slip.xml (Coulomb friction with exact stick, whose sticking
+    points are rows of the saddle-point step),
 
 both runs must converge with max |v_e/V_e - 1| <= 1e-10, conform to
 interface.md, and agree on every step's support and capstan forces, the final
@@ -32,6 +35,7 @@ CASES = [
     ("g1 2x", "seed/g1.xml", ["Mesh/Cells={28,8,12}", "Time/Steps=2", "Solver/Linear Solver=GMRES",
                               "Solver/Preconditioner=MueLu"]),
     ("h1", "seed/h1.xml", []),
+    ("stick-slip", "seed/stick-slip.xml", []),
 ]
 
 for label, scene_name, sets in CASES:
