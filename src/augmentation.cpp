@@ -92,12 +92,17 @@ bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string
     if (log_.on("newton")) {
       std::string text = "newton |R|:";
       for (double n : r.residualHistory) text += format(" %.3e", n);
+      if (!r.stepLengths.empty()) {
+        text += "  steps:";
+        for (double a : r.stepLengths) text += format(" %.2g", a);
+      }
       text += format("  (%d linear; preconditioners built: %d; %.3f s)", r.linearIterations,
                      m_.newton->preconditionerBuilds(), solveSeconds);
       std::vector<double> history(r.residualHistory.begin(), r.residualHistory.end());
       if (log_.on("newton"))
         log_.event("newton", text,
                  eventOf("newton").add("pass", json::number(it)).add("residuals", json::array(history))
+                     .add("step_lengths", json::array(r.stepLengths))
                      .add("converged", r.converged ? "true" : "false")
                      .add("linear_iterations", json::number(r.linearIterations))
                      .add("preconditioners_built", json::number(m_.newton->preconditionerBuilds()))

@@ -4,6 +4,7 @@
 #include <Kokkos_Timer.hpp>
 #include <NOX.H>
 #include <NOX_Observer.hpp>
+#include <NOX_Solver_LineSearchBased.H>
 #include <NOX_Thyra.H>
 #include <NOX_Thyra_Group.H>
 #include <Stratimikos_DefaultLinearSolverBuilder.hpp>
@@ -179,13 +180,14 @@ class BodyModel : public Thyra::StateFuncModelEvaluatorBase<double> {
 class History : public NOX::Observer {
  public:
   explicit History(LagPolicy* lag = nullptr) : lag_(lag) {}
-  std::vector<double> norms;
-  void runPreSolve(const NOX::Solver::Generic&) override { norms.clear(); }
+  std::vector<double> norms, steps;
+  void runPreSolve(const NOX::Solver::Generic&) override { norms.clear(), steps.clear(); }
   void runPreIterate(const NOX::Solver::Generic& s) override {
     if (norms.empty() && s.getSolutionGroup().isF()) norms.push_back(s.getSolutionGroup().getNormF());
   }
   void runPostIterate(const NOX::Solver::Generic& s) override {
     norms.push_back(s.getSolutionGroup().getNormF());
+    if (const auto* ls = dynamic_cast<const NOX::Solver::LineSearchBased*>(&s)) steps.push_back(ls->getStepSize());
     if (!lag_) return;
     const Teuchos::ParameterList* list = &s.getList();
     for (const char* name : {"Direction", "Newton", "Linear Solver", "Output"}) {
@@ -616,6 +618,7 @@ NewtonResult NewtonSolver::solve(Vector& u, double tolerance) {
   auto& out = params->sublist("Direction").sublist("Newton").sublist("Linear Solver").sublist("Output");
   r.linearIterations = out.get("Cumulative Iteration Count", 0);
   r.residualHistory = history->norms;
+  r.stepLengths = history->steps;
   r.converged = status == NOX::StatusTest::Converged && r.failure.empty() && std::isfinite(r.residualNorm);
   if (!r.converged && r.failure.empty()) {
     if (finite->getStatus() == NOX::StatusTest::Failed) r.failure = "residual is not finite (NaN/Inf)";

@@ -21,6 +21,7 @@ struct NewtonResult {
   int linearIterations = 0;
   double residualNorm = 0;
   std::vector<double> residualHistory;  // |R| at the start and after each iteration
+  std::vector<double> stepLengths;      // the line search's step length at each iteration
   std::string failure;                  // why it did not converge
 };
 

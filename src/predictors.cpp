@@ -20,11 +20,12 @@ double Predictors::firstGuess(double t0, double t, StepRecord& rec) {
   // moved on by one increment of the roller's turn), which the linear response
   // from a state at rest cannot see: the shape shifted along the streamlines,
   // else the last increment extrapolated.
+  const std::vector<double> turns = coreTurns(t0, t);
   bool continued = m_.rolling && previous_ && tPrevious_ < t0 &&
-                   (shiftAlongStreamlines(t0, t) || extrapolate(t0, t, bare, f));
+                   (shiftAlongStreamlines(t0, t, turns) || extrapolate(t0, t, bare, f));
   // From the bare state every point of a driven roller's nip slips and the
   // core's rotation has almost no stiffness: turn the body with the core first.
-  bool rolled = !continued && rollWithCores(t0, t);
+  bool rolled = !continued && rollWithCores(turns);
   // A step that barely changes anything (steady rolling) needs no predictor.
   if (!continued && !rolled && m_.scene.solver.predictor == SolverSettings::Predictor::Tangent &&
       bare > 1e-8 * m_.forceScale)
@@ -81,10 +82,9 @@ std::vector<double> Predictors::coreTurns(double t0, double t) const {
   return dTheta;
 }
 
-bool Predictors::shiftAlongStreamlines(double t0, double t) {
+bool Predictors::shiftAlongStreamlines(double t0, double t, const std::vector<double>& dTheta) {
   if (m_.scene.solver.rollingPredictor != SolverSettings::RollingPredictor::StreamlineShift || tPrevious_ <= 0)
     return false;
-  const std::vector<double> dTheta = coreTurns(t0, t);
   // One turning core: the shift keeps one body's shape about one axis.
   if (std::count_if(dTheta.begin(), dTheta.end(), [](double x) { return x != 0; }) != 1) return false;
   const size_t c = size_t(std::find_if(dTheta.begin(), dTheta.end(), [](double x) { return x != 0; }) - dTheta.begin());
@@ -108,8 +108,7 @@ bool Predictors::shiftAlongStreamlines(double t0, double t) {
   return true;
 }
 
-bool Predictors::rollWithCores(double t0, double t) {
-  const std::vector<double> dTheta = coreTurns(t0, t);
+bool Predictors::rollWithCores(const std::vector<double>& dTheta) {
   if (std::none_of(dTheta.begin(), dTheta.end(), [](double x) { return x != 0; })) return false;
   m_.assembly->rollWithCores(*m_.u, dTheta);
   if (log_.on("newton"))

@@ -34,15 +34,17 @@ class Predictors {
   // Rolling: u extrapolated along the last converged increment; true if kept.
   bool extrapolate(double t0, double t1, double bare, Vector& f);
   // Rolling: each free core's turn in the increment, at its last angular
-  // velocity (at first: rolling without slip).
+  // velocity (at first: rolling without slip), from the cores' records of the
+  // converged state (the bare evaluation: a rejected extrapolation's
+  // evaluation leaves its own there, a turn ahead).
   std::vector<double> coreTurns(double t0, double t1) const;
-  // Rolling: the body turned with each free core; true if any core turned.
-  bool rollWithCores(double t0, double t1);
+  // Rolling: the body turned with each free core by dTheta; true if any core turned.
+  bool rollWithCores(const std::vector<double>& dTheta);
   // Rolling, Solver/Rolling Predictor = Streamline Shift (the default), from
   // the third step on (the second starts from rest: its last increment is no
   // rolling): the body's shape kept in space as one free core turns
   // (src/streamline_shift.hpp); true if done.
-  bool shiftAlongStreamlines(double t0, double t1);
+  bool shiftAlongStreamlines(double t0, double t1, const std::vector<double>& dTheta);
   // K_ff du = -(R + K z)_f from the converged state and the prescribed
   // increment z; kept if it beats the bare increment.
   void tangent(double t0, double t1, double bare, StepRecord& rec);

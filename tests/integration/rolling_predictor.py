@@ -10,7 +10,9 @@ inputs/pinch-roller-slice.xml (20 steps):
     jump from step to step by up to 1e-2; the shift changes the first guess, not the
     equations);
   * on 2 ranks (8 steps) the same Newton iterations and every step's capstan force and
-    speed ratio within 1e-8 of 1 rank's (the shift gathers every node's displacement).
+    speed ratio within 1e-8 of 1 rank's (the shift gathers every node's displacement);
+  * the 3D drive's second step (no shift yet, its extrapolation rejected) turns the body
+    by the first step's turn, and is not cut.
 """
 import os
 import statistics
@@ -62,5 +64,22 @@ if one and two:
     T.check(len(two["steps"]) == 8 and worst <= 1e-8, f"1 and 2 ranks: forces and speed ratios agree ({worst:.1e})")
 else:
     T.check(False, "the slice with the shift converges on 1 and 2 ranks")
+
+# The second step of the 3D drive cannot shift (its last increment started from rest):
+# its extrapolation is rejected there, and the body is turned with the core by the
+# first step's turn. The rejected trial's evaluation once left the core a turn ahead,
+# so the body was turned twice as far and the step's first solve crawled to Newton's
+# limit and was cut.
+drive = T.input("pinch-roller.xml")
+_, two_steps, out = T.run_scene(drive, "drive 2 steps", sets=["Time/Steps=2", NO_FIELDS], extra=["--log", "newton"])
+if two_steps:
+    rolled = [e for e in T.log_events(out, "rolled") if e["step"] == 2]
+    turn = two_steps["steps"][0]["supports"]["core"]["rotation"]
+    T.check(len(rolled) == 1 and abs(rolled[0]["angle"] - turn) <= 1e-12 * abs(turn),
+            f"drive step 2: the body turned by the first step's turn {turn:.6g} "
+            f"({[e['angle'] for e in rolled]})")
+    T.check(two_steps["steps"][1]["cutbacks"] == 0, "drive step 2: no cut")
+else:
+    T.check(False, "the drive's first 2 steps converge")
 
 T.finish()
