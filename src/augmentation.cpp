@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <optional>
 
 #include "effect_state.hpp"
 
@@ -52,6 +53,13 @@ bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string
   for (const auto& e : effects) maxOuter = std::max(maxOuter, e->maxAugmentations());
   AndersonMixing mixing(sol.pressureAccelerationDepth, m_.comm);
   const double polishBelow = m_.pressureStep ? kPolishBelow * tol : m_.absTolerance;
+  // The state before the last saddle-point step, while the pass after it runs.
+  struct StepStart {
+    RCP<Vector> u;
+    EffectState state;                  // the multipliers after their plain update
+    std::vector<double> pressureNext;   // the mixed effects' plain update
+  };
+  std::optional<StepStart> beforeStep;
   Vector f(m_.u->getMap());
   for (int it = 1; it <= maxOuter; ++it) {
     // Later passes: down to round-off, 1e-3 x the absolute tolerance.
@@ -111,10 +119,25 @@ bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string
     // A later pass may start below what round-off lets Newton reach; a state
     // within the absolute tolerance is as converged as it gets.
     if (!r.converged && !(it > 1 && r.residualNorm <= m_.absTolerance)) {
+      if (beforeStep) {
+        // The saddle-point step's linear model broke down (stick and slip
+        // change over it near the traction limit): back to where it started,
+        // with the plain update instead, rather than a cut step.
+        if (log_.on("newton"))
+          log_.event("newton", format("newton failed (%s) after the pressure step: a plain pass from before it",
+                                      r.failure.c_str()),
+                     eventOf("pressure_step_undone").add("failed_iterations", json::number(r.iterations)));
+        m_.u->update(1.0, *beforeStep->u, 0.0);
+        restoreState(effects, beforeStep->state);
+        setMultipliers(effects, beforeStep->pressureNext, true);
+        beforeStep.reset();
+        continue;
+      }
       if (checkTangent_) checkTangent();
       failure = r.failure;
       return false;
     }
+    beforeStep.reset();
     // Refresh p(x), v, contact pressures at the converged state.
     assembly.evaluate(*m_.u, &f, nullptr);
     bool met = true, volumeMet = true, rowsUnmet = false;
@@ -149,8 +172,18 @@ bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string
       // volumes it makes exact.
       const std::vector<double> pressureNext = multiplierMap(effects, true);  // at the converged state
       setMultipliers(effects, multiplierMap(effects, false), false, settled);
-      if ((!volumeMet || rowsUnmet) && !saddlePointPressureStep(t, f, volumeMet, rec))  // no progress: a plain pass instead
-        setMultipliers(effects, pressureNext, true);
+      // Mixed effects other than the bricks (steady friction) take their plain
+      // update here too: the step moves only the rows it has.
+      std::vector<const Effect*> keep = settled;
+      keep.push_back(&assembly.bricks());
+      setMultipliers(effects, pressureNext, true, keep);
+      if (!volumeMet || rowsUnmet) {
+        beforeStep = StepStart{rcp(new Vector(*m_.u, Teuchos::Copy)), saveState(effects), pressureNext};
+        if (!saddlePointPressureStep(t, f, volumeMet, rec)) {  // no progress: a plain pass instead
+          setMultipliers(effects, pressureNext, true);
+          beforeStep.reset();
+        }
+      }
       continue;
     }
     setMultipliers(effects, mixing.next(multipliers(effects, true), multiplierMap(effects, true)), true);

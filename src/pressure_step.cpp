@@ -60,22 +60,47 @@ void PressureStep::fillRows() {
   auto D = diagonal_->getDataNonConst();
   auto sInv = schurInverse_->getDataNonConst();
   auto vs = volumeScale_->getDataNonConst();
-  std::vector<size_t> start;
-  std::vector<GO> cols;
-  std::vector<double> vals;
+  std::vector<size_t> start, columnStart;
+  std::vector<GO> cols, columnCols;
+  std::vector<double> vals, columnVals;
+  // Separate columns (ConstraintRows::column): every row's dR/dmu_j, chained.
+  // (On every rank alike: the matrix is built and applied collectively.)
+  int anyColumn = std::any_of(effectRows_.begin(), effectRows_.end(),
+                              [](const ConstraintRows& r) { return r.size() > 0 && r.column.extent(0) > 0; }),
+      anyColumnGlobal = 0;
+  Teuchos::reduceAll(*comm, Teuchos::REDUCE_MAX, anyColumn, Teuchos::outArg(anyColumnGlobal));
+  const bool ownColumns = anyColumnGlobal > 0;
+  std::vector<size_t> allColumnStart(1, 0);
+  std::vector<GO> allColumnCols;
+  std::vector<double> allColumnVals;
   size_t j = 0;
   for (size_t i = 0; i < effects.size(); ++i) {
     const ConstraintRows& r = effectRows_[i];
     if (r.size() == 0) continue;
     assembly_.chainRows(*effects[i], r.gradient, start, cols, vals, &r.entity);
-    auto grad = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), r.gradient);
+    const bool column = r.column.extent(0) > 0;
+    if (column) assembly_.chainRows(*effects[i], r.column, columnStart, columnCols, columnVals, &r.entity);
+    auto grad = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), column ? r.column : r.gradient);
     for (size_t k = 0; k < r.size(); ++k, ++j) {
       double norm2 = 0;
       for (size_t l = 0; l < grad.extent(1); ++l) norm2 += grad(k, l) * grad(k, l);
       // A row with no free dof (all its nodes held) is no constraint: weight 0
       // keeps its equation and its dmu at 0.
       const bool empty = start[k + 1] == start[k];
-      w[j] = empty ? 0.0 : std::fabs(r.force[k]) * std::sqrt(norm2) / std::fabs(r.schur[k]);
+      // w_j = |dR/dmu_j| / |S_j|.
+      w[j] = empty ? 0.0 : (column ? 1.0 : std::fabs(r.force[k])) * std::sqrt(norm2) / std::fabs(r.schur[k]);
+      if (ownColumns) {
+        if (column) {
+          allColumnCols.insert(allColumnCols.end(), columnCols.begin() + long(columnStart[k]),
+                               columnCols.begin() + long(columnStart[k + 1]));
+          allColumnVals.insert(allColumnVals.end(), columnVals.begin() + long(columnStart[k]),
+                               columnVals.begin() + long(columnStart[k + 1]));
+        } else {
+          allColumnCols.insert(allColumnCols.end(), cols.begin() + long(start[k]), cols.begin() + long(start[k + 1]));
+          for (size_t l = start[k]; l < start[k + 1]; ++l) allColumnVals.push_back(r.force[k] * vals[l]);
+        }
+        allColumnStart.push_back(allColumnCols.size());
+      }
       sInv[j] = empty ? 0.0 : 1 / (w[j] * r.schur[k]);
       F[j] = r.force[k], D[j] = r.diagonal[k];
       vs[j] = empty ? 0.0 : w[j] * r.scale[k];
@@ -103,6 +128,20 @@ void PressureStep::fillRows() {
       gradient_->insertGlobalValues(gid, row(cols_, k), row(vals_, k));
   }
   gradient_->fillComplete(assembly_.dofMap(), rowMap_);
+  columns_ = Teuchos::null;
+  if (!ownColumns) return;
+  size_t longest = 1;
+  for (size_t k = 0; k + 1 < allColumnStart.size(); ++k)
+    longest = std::max(longest, allColumnStart[k + 1] - allColumnStart[k]);
+  columns_ = rcp(new CrsMatrix(rowMap_, longest));
+  for (size_t k = 0; k + 1 < allColumnStart.size(); ++k) {
+    const size_t n = allColumnStart[k + 1] - allColumnStart[k];
+    if (n == 0) continue;
+    columns_->insertGlobalValues(rowMap_->getGlobalElement(LO(k)),
+                                 Teuchos::ArrayView<const GO>(allColumnCols.data() + allColumnStart[k], n),
+                                 Teuchos::ArrayView<const double>(allColumnVals.data() + allColumnStart[k], n));
+  }
+  columns_->fillComplete(assembly_.dofMap(), rowMap_);
 }
 
 void PressureStep::buildVolumeLaplacian(const CrsMatrix& K) {
@@ -180,8 +219,12 @@ void PressureStep::applyVolumeLaplacianInverse(const Vector& b, Vector& x) const
 void PressureStep::applySystem(const CrsMatrix& K, const Block& x, Block& y) const {
   // y_u = K x_u + B F x_c
   K.apply(*x.u, *y.u);
-  scratchC_->elementWiseMultiply(1.0, *force_, *x.c, 0.0);
-  gradient_->apply(*scratchC_, *y.u, Teuchos::TRANS, 1.0, 1.0);
+  if (columns_.is_null()) {
+    scratchC_->elementWiseMultiply(1.0, *force_, *x.c, 0.0);
+    gradient_->apply(*scratchC_, *y.u, Teuchos::TRANS, 1.0, 1.0);
+  } else {
+    columns_->apply(*x.c, *y.u, Teuchos::TRANS, 1.0, 1.0);
+  }
   // y_c = w .* (B^T x_u + D x_c)
   gradient_->apply(*x.u, *y.c);
   y.c->elementWiseMultiply(1.0, *diagonal_, *x.c, 1.0);
@@ -197,9 +240,13 @@ void PressureStep::applyPreconditioner(const Inverse& Kinv, const Block& r, Bloc
     applyVolumeLaplacianInverse(*laplacianIn_, *laplacianOut_);
     z.c->update(kLaplacianWeight, *laplacianOut_, 1.0);
   }
-  scratchC_->elementWiseMultiply(1.0, *force_, *z.c, 0.0);
   scratch_->update(1.0, *r.u, 0.0);
-  gradient_->apply(*scratchC_, *scratch_, Teuchos::TRANS, -1.0, 1.0);
+  if (columns_.is_null()) {
+    scratchC_->elementWiseMultiply(1.0, *force_, *z.c, 0.0);
+    gradient_->apply(*scratchC_, *scratch_, Teuchos::TRANS, -1.0, 1.0);
+  } else {
+    columns_->apply(*z.c, *scratch_, Teuchos::TRANS, -1.0, 1.0);
+  }
   Kinv(*scratch_, *z.u);
 }
 

@@ -133,6 +133,9 @@ class PressureStep {
   long rows_ = 0;
   RCP<const Map> rowMap_;             // this rank's constraint rows, effect after effect
   RCP<CrsMatrix> gradient_;           // B^T: row j holds B_j on the free dofs
+  // Row j: dR/dmu_j on the free dofs, where some effect's rows give their own
+  // columns (ConstraintRows::column); null: the columns are F_j B_j.
+  RCP<CrsMatrix> columns_;
   // Rows of B^T over global dofs (Assembly::chainRows), refilled per solve;
   // the last pattern, to refill the matrix in place while it is unchanged.
   std::vector<size_t> rowStart_, lastRowStart_;

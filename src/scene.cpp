@@ -726,7 +726,7 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
                        std::any_of(sc.supports.begin(), sc.supports.end(), [](const SupportSpec& s) {
                          return s.isCore() && s.rotation == SupportSpec::Rotation::Free;
                        });
-  sc.solver = SolverSettings::parse(P.sublist("Solver"), ParameterReader{file}, friction, rolling);
+  sc.solver = SolverSettings::parse(P.sublist("Solver"), ParameterReader{file}, friction, rolling, sc.analysis.steady());
   for (const auto& c : sc.capstans)
     if (c.friction.on() && sc.solver.linearSolver == SolverSettings::LinearSolver::CG)
       v.fail("Solver/Linear Solver", "CG needs a symmetric matrix; friction on capstan '" + c.name +

@@ -58,9 +58,9 @@ void SolverSettings::declare(ParameterList& sol) {
           "How the pressure loop moves the element pressure anchors after each Newton solve: "
           "Saddle Point (positions, anchors, exact contact's multipliers and Coulomb's stick tractions from one block Krylov solve, "
           "v_e = V_e and g = 0 to first order), "
-          "Anderson (pbar <- p(x), Anderson-accelerated), or Auto (Saddle Point without friction and for a "
-          "free-turning core rolling with friction in the quasi-static analysis, Anderson for other friction "
-          "scenes; docs/friction.md, \"The multiplier loop\")");
+          "Anderson (pbar <- p(x), Anderson-accelerated), or Auto (Saddle Point without friction, for a "
+          "free-turning core rolling with friction in the quasi-static analysis and for steady rolling; "
+          "Anderson for other friction scenes; docs/friction.md, \"The multiplier loop in rolling\")");
   sol.set("Pressure Step Schur", std::string("Auto"),
           "The saddle-point step's approximation of its volume rows' Schur complement: Laplacian "
           "((eps V)^-1 + 0.15 L^-1, L = G^T diag(K0)^-1 G by 30 CG iterations: it holds Q1P0's nearly "
@@ -78,7 +78,7 @@ void SolverSettings::declare(ParameterList& sol) {
 }
 
 SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterReader& r, bool friction,
-                                     bool rolling) {
+                                     bool rolling, bool steady) {
   const std::string at = "Solver";
   SolverSettings s;
   s.linearSolver = r.choice(sol, at, "Linear Solver", linearSolvers);
@@ -113,17 +113,19 @@ SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterRe
   s.volumeTolerance = r.fraction(sol, at, "Volume Tolerance");
   s.maxPressureIterations = r.atLeast(sol, at, "Max Pressure Iterations", 1);
   // Auto: the saddle-point step without friction (docs/performance.md,
-  // "Defaults and why"), and for quasi-static rolling with friction, whose
+  // "Defaults and why"), for quasi-static rolling with friction, whose
   // multipliers move with the streamline shift (the fast rollers 51.7 Newton
-  // iterations per step against 83.5 with Anderson). Other friction scenes
-  // keep Anderson: with the step H4 fails under Arctan, and steady rolling
-  // fails (docs/friction.md, "The multiplier loop").
+  // iterations per step against 83.5 with Anderson), and for steady rolling,
+  // with Coulomb's sticking points among its rows (the steady drive 98 Newton
+  // iterations against 168). Other friction scenes keep Anderson: with the step
+  // H4 at k = 0.01 takes another stick/slip path, 1.3e-4 from its finely
+  // stepped reference (docs/friction.md, "The multiplier loop in rolling").
   enum class Update { Auto, SaddlePoint, Anderson };
   const Update update = r.choice(sol, at, "Pressure Update",
                                  std::vector<std::pair<const char*, Update>>{{"Auto", Update::Auto},
                                                                              {"Saddle Point", Update::SaddlePoint},
                                                                              {"Anderson", Update::Anderson}});
-  s.pressureUpdate = update == Update::SaddlePoint || (update == Update::Auto && (!friction || rolling))
+  s.pressureUpdate = update == Update::SaddlePoint || (update == Update::Auto && (!friction || rolling || steady))
                          ? PressureUpdate::SaddlePoint
                          : PressureUpdate::Anderson;
   s.pressureStepSchur = r.choice(sol, at, "Pressure Step Schur",
@@ -180,10 +182,10 @@ SolverSettings SolverSettings::resolved(long dofs, bool annulus, bool friction, 
   return s;
 }
 
-SolverSettings SolverSettings::defaults(bool friction, bool rolling) {
+SolverSettings SolverSettings::defaults(bool friction, bool rolling, bool steady) {
   ParameterList list;
   declare(list);
-  return parse(list, ParameterReader{"(defaults)"}, friction, rolling);
+  return parse(list, ParameterReader{"(defaults)"}, friction, rolling, steady);
 }
 
 }  // namespace capstan

@@ -51,16 +51,17 @@ struct SolverSettings {
 
   static void declare(Teuchos::ParameterList& solver);
   // `friction`: some capstan has friction; `rolling`: a free-turning rigid
-  // core in the quasi-static analysis (Pressure Update = Auto picks Anderson
-  // with friction unless rolling).
+  // core in the quasi-static analysis; `steady`: the steady-rolling analysis
+  // (Pressure Update = Auto picks Anderson with friction unless rolling or
+  // steady).
   static SolverSettings parse(const Teuchos::ParameterList& solver, const ParameterReader& r, bool friction,
-                              bool rolling = false);
+                              bool rolling = false, bool steady = false);
   // Linear Solver = Auto and Preconditioner = Auto resolved for a problem of
   // `dofs` unknowns on an annulus (or box) mesh, with or without friction
   // (docs/performance.md, "Linear solvers", has the measurements).
   SolverSettings resolved(long dofs, bool annulus, bool friction, bool steady = false) const;
   // The defaults (tests, benchmarks).
-  static SolverSettings defaults(bool friction = false, bool rolling = false);
+  static SolverSettings defaults(bool friction = false, bool rolling = false, bool steady = false);
 
   static const std::vector<std::pair<const char*, LinearSolver>> linearSolvers;
   static const std::vector<std::pair<const char*, LineSearch>> lineSearches;

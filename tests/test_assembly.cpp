@@ -14,6 +14,7 @@
 #include "errors.hpp"
 #include "newton.hpp"
 #include "pressure_step.hpp"
+#include "pressure_step_check.hpp"
 
 using namespace capstan;
 
@@ -397,36 +398,12 @@ TEST(PressureStep, SchurModelsGiveTheSameStep) {
 
 namespace {
 
-// Each rank's constraint values c_j by (effect, multiplier index, row of that
-// multiplier: a stick traction has one per tangent), at the last evaluation.
-using RowKey = std::tuple<size_t, int, int>;
-std::map<RowKey, double> constraintValues(Assembly& assembly) {
-  std::map<RowKey, double> out;
-  ConstraintRows rows;
-  for (size_t i = 0; i < assembly.effects().size(); ++i) {
-    assembly.effects()[i]->constraintRows(assembly.positions(), rows);
-    std::map<int, int> seen;
-    for (size_t k = 0; k < rows.size(); ++k) out[{i, rows.multiplier[k], seen[rows.multiplier[k]]++}] = rows.value[k];
-  }
-  return out;
-}
+using test::StepCheck;
 
 // A box under a capstan that presses its top face (exact contact), with the
 // capstan's friction law, solved by the saddle-point step at the box's field
-// state, over the increment (0, dt). Checked through the assembly's own
-// residual and constraint values:
-// - the momentum rows K dx + (R(mu + s dmu) - R(mu)) / s + R = 0, to 1e-8 (R is
-//   linear in every multiplier while the points keep their contact and stick
-//   states);
-// - every row's linearisation c_j + dc_j/dx . dx = 0, a central difference
-//   along dx: returned per effect as max |c + dc/dx dx| / max |c| (all ranks).
-struct StepCheck {
-  PressureStep::Result result;
-  std::map<std::string, double> rowError;  // by effect name
-  std::map<std::string, long> rows;        // by effect name, all ranks
-};
+// state, over the increment (0, dt): tests/pressure_step_check.hpp.
 StepCheck checkStepOnPressedBox(const FrictionSettings& friction, double dt) {
-  auto comm = Tpetra::getDefaultComm();
   Scene scene = boxScene();
   CapstanSpec cap;
   cap.name = "capstan";
@@ -444,77 +421,11 @@ StepCheck checkStepOnPressedBox(const FrictionSettings& friction, double dt) {
   auto& [sc, mesh, assembly, newton, u, f] = problem;
   assembly.setInterval(0.0, dt);
   auto W = newton.matrix();
-  StepCheck out;
   if (!assembly.evaluate(u, &f, W.get())) {
     ADD_FAILURE() << "box state not valid";
-    return out;
+    return {};
   }
-  const auto c0 = constraintValues(assembly);
-
-  std::vector<Kokkos::View<double*>> dmu;
-  PressureStep step(assembly);
-  Vector dx(assembly.dofMap());
-  out.result = step.solve(*W, newton.approximateInverse(), f, 1e-12, 0.0, 500, dx, dmu);
-  EXPECT_LT(out.result.reduction, 1e-11);
-
-  // Momentum rows.
-  std::vector<std::vector<double>> mu0;
-  for (const auto& e : assembly.effects()) {
-    auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), e->multipliers());
-    mu0.emplace_back(h.data(), h.data() + h.size());
-  }
-  auto setMultipliers = [&](double s) {
-    for (size_t i = 0; i < mu0.size(); ++i) {
-      auto mu = assembly.effects()[i]->multipliers();
-      if (mu.extent(0) == 0) continue;
-      auto h = Kokkos::create_mirror_view(mu);
-      auto d = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), dmu[i]);
-      for (size_t k = 0; k < h.extent(0); ++k) h(k) = mu0[i][k] + s * d(k);
-      Kokkos::deep_copy(mu, h);
-    }
-  };
-  const double s = 1e-4;
-  Vector Kdx(assembly.dofMap()), fs(assembly.dofMap());
-  W->apply(dx, Kdx);
-  setMultipliers(s);
-  EXPECT_TRUE(assembly.evaluate(u, &fs, nullptr));
-  setMultipliers(0);
-  fs.update(-1 / s, f, 1 / s);  // (R(mu + s dmu) - R(mu)) / s
-  Kdx.update(1.0, fs, 1.0, f, 1.0);
-  const double momentum = Kdx.norm2(), scale = f.norm2() + fs.norm2();
-  EXPECT_GT(scale, 0);
-  EXPECT_LT(momentum, 1e-8 * scale) << "|K dx + B F dmu + R| = " << momentum;
-
-  // Constraint rows: (c(u + h dx) - c(u - h dx)) / 2h = -c (D = 0 here: exact
-  // contact and stick, and the anchors do not enter v).
-  const double h = 1e-5;
-  std::map<RowKey, double> cp, cm;
-  for (double sign : {1.0, -1.0}) {
-    Vector us(u, Teuchos::Copy);
-    us.update(sign * h, dx, 1.0);
-    EXPECT_TRUE(assembly.evaluate(us, nullptr, nullptr));
-    (sign > 0 ? cp : cm) = constraintValues(assembly);
-  }
-  const size_t n = assembly.effects().size();
-  std::vector<double> worst(n, 0.0), largest(n, 0.0), count(n, 0.0);
-  for (const auto& [key, c] : c0) {
-    const size_t i = std::get<0>(key);
-    EXPECT_TRUE(cp.count(key) && cm.count(key)) << "row " << i << "/" << std::get<1>(key) << " changed state";
-    if (!cp.count(key) || !cm.count(key)) continue;
-    worst[i] = std::max(worst[i], std::fabs((cp[key] - cm[key]) / (2 * h) + c));
-    largest[i] = std::max(largest[i], std::fabs(c));
-    count[i] += 1;
-  }
-  for (size_t i = 0; i < n; ++i) {
-    double w = 0, l = 0, rows = 0;
-    Teuchos::reduceAll(*comm, Teuchos::REDUCE_MAX, worst[i], Teuchos::outArg(w));
-    Teuchos::reduceAll(*comm, Teuchos::REDUCE_MAX, largest[i], Teuchos::outArg(l));
-    Teuchos::reduceAll(*comm, Teuchos::REDUCE_SUM, count[i], Teuchos::outArg(rows));
-    const std::string& name = assembly.effects()[i]->name();
-    out.rows[name] = long(rows);
-    if (rows > 0) out.rowError[name] = l > 0 ? w / l : w;
-  }
-  return out;
+  return test::checkPressureStep(assembly, newton, u, f, *W);
 }
 
 }  // namespace
@@ -525,8 +436,10 @@ TEST(PressureStep, MovesContactMultipliersWithTheVolumes) {
   const StepCheck check = checkStepOnPressedBox(FrictionSettings(), 0.0);
   EXPECT_GT(check.result.contactRows, 8) << "the capstan must press the top face";
   ASSERT_EQ(check.rowError.size(), 2u) << "rows of the bricks and the contact";
-  for (const auto& [name, error] : check.rowError)
+  for (const auto& [name, error] : check.rowError) {
     EXPECT_LT(error, 1e-5) << name << " rows: max |c + dc/dx dx| / max |c|";
+    EXPECT_LT(check.columnError.at(name), 1e-8) << name << " columns";
+  }
 }
 
 // With Coulomb friction (augmented Lagrangian) the sticking points get two rows
@@ -544,7 +457,9 @@ TEST(PressureStep, MovesStickTractionsWithTheVolumes) {
   EXPECT_GT(contact, 8);
   EXPECT_EQ(stick, 2 * contact) << "two tangents per point in contact";
   for (const auto& [name, error] : check.rowError) {
-    std::printf("%s rows: max |c + dc/dx dx| / max |c| = %.2e\n", name.c_str(), error);
+    std::printf("%s rows: max |c + dc/dx dx| / max |c| = %.2e; columns %.2e\n", name.c_str(), error,
+                check.columnError.at(name));
     EXPECT_LT(error, name == "friction:capstan" ? 5e-2 : 1e-5) << name;
+    EXPECT_LT(check.columnError.at(name), 1e-8) << name << " columns";
   }
 }

@@ -703,3 +703,13 @@ TEST(SolverSettings, AutoResolvesByKindAndSize) {
   EXPECT_EQ(pick(own, 1575, true, true), std::make_pair(S::LinearSolver::GMRES, S::Preconditioner::MueLu));
   EXPECT_EQ(pick(own, 500, true, true), std::make_pair(S::LinearSolver::GMRES, S::Preconditioner::ILU));
 }
+
+// Pressure Update = Auto by the scene's kind (docs/friction.md, "The multiplier
+// loop in rolling"): the saddle-point step but for non-rolling friction scenes.
+TEST(SolverSettings, PressureUpdateAutoByKind) {
+  using P = SolverSettings::PressureUpdate;
+  EXPECT_EQ(SolverSettings::defaults(false).pressureUpdate, P::SaddlePoint) << "no friction";
+  EXPECT_EQ(SolverSettings::defaults(true).pressureUpdate, P::Anderson) << "friction, no rolling (H1-H5)";
+  EXPECT_EQ(SolverSettings::defaults(true, true).pressureUpdate, P::SaddlePoint) << "quasi-static rolling";
+  EXPECT_EQ(SolverSettings::defaults(true, false, true).pressureUpdate, P::SaddlePoint) << "steady rolling";
+}

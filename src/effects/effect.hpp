@@ -120,10 +120,15 @@ struct ConstraintRows {
   // of a vector multiplier (multipliers()[multiplier_j + i], i < 3) along this
   // unit direction (a stick traction along a tangent of the capstan).
   std::vector<double> direction;
+  // Empty: dR/dmu_j = force_j gradient_j. Otherwise [j][k]: dR/dmu_j over the
+  // entity's dofs, where it differs (steady friction: a stick row's slip spans
+  // the upstream nodes, its traction only the face's).
+  Matrix column;
   size_t size() const { return entity.size(); }
   void clear() {
     entity.clear(), multiplier.clear(), force.clear(), diagonal.clear(), value.clear(), schur.clear(), scale.clear();
     direction.clear();
+    column = Matrix();
   }
 };
 

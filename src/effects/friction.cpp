@@ -149,7 +149,7 @@ void FrictionEffect::multiplierMap(const Kokkos::View<double*>& next) const {
 void FrictionEffect::constraintRows(const NodalVectors&, ConstraintRows& rows) const {
   rows.clear();
   rows.gradient = Matrix();
-  if (!augmented() || parameters_.smoothing > 0) return;
+  if (!stepsForItself()) return;
   // On the host: the points of the nip only.
   auto pts = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), points_);
   auto lambdaT = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), tangentialMultipliers_);

@@ -53,7 +53,12 @@ class FrictionEffect : public Effect {
   // the slip's curvature terms (spin / R), and the Schur diagonal is -eps_t.
   // Without these rows the plain update lambda_T <- t gains only 1.3-2x a pass.
   void constraintRows(const NodalVectors& x, ConstraintRows& rows) const override;
-  bool stepsForItself() const override { return augmented() && parameters_.smoothing == 0; }
+  // Rows only at the nodal rule's points (one per face node, as exact contact
+  // has): with Gauss points, 2 rows per point outnumber the nodes' tangential
+  // dofs and the step's system is singular.
+  bool stepsForItself() const override {
+    return augmented() && parameters_.smoothing == 0 && contact_.rule() == kernels::FaceRule::Nodal;
+  }
   double constraintViolation() const override;
   double constraintTolerance() const override { return contact_.constraintTolerance(); }
   std::string constraintName() const override { return name() + " stick slip"; }

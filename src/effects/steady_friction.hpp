@@ -39,12 +39,13 @@ class SteadyFrictionEffect : public FrictionEffect {
   bool augmented() const override { return settings_.law == FrictionSettings::Law::Coulomb; }
   bool accelerated() const override { return true; }
   int multiplierSites(std::vector<int>&) const override { return 0; }  // the mesh stands still: no shift
-  // Its entities span the upstream nodes too: the stick rows are not built for them.
-  void constraintRows(const NodalVectors&, ConstraintRows& rows) const override {
-    rows.clear();
-    rows.gradient = Matrix();
-  }
-  bool stepsForItself() const override { return false; }
+  // Coulomb's sticking points in the saddle-point step, as in the quasi-static
+  // analysis (FrictionEffect::constraintRows), but the slip spans the face's
+  // entity: c = tau . du_t with du = spin tau_c - sum_a N_a flow tau_f
+  // (dx/dtheta)_a, so dc/dx_k = -flow sum_a N_a W_ak tau and dc/domega =
+  // -dflow sum_a N_a tau . travel_a, while the traction acts on the face's
+  // nodes only (ConstraintRows::column: -w N_a tau).
+  void constraintRows(const NodalVectors& x, ConstraintRows& rows) const override;
   // Steady rolling's start: friction off (a frictionless footprint first).
   void setEnabled(bool on) { enabled_ = on; }
   // The flow's angular velocity scale: the no-slip estimate about +z.
