@@ -146,10 +146,8 @@ void FrictionEffect::multiplierMap(const Kokkos::View<double*>& next) const {
       });
 }
 
-void FrictionEffect::constraintRows(const NodalVectors&, ConstraintRows& rows) const {
-  rows.clear();
-  rows.gradient = Matrix();
-  if (!stepsForItself()) return;
+void FrictionEffect::stickRows(ConstraintRows& rows, int width, const StickRowFill& fill, std::vector<double>& grad,
+                               std::vector<double>& column) const {
   // On the host: the points of the nip only.
   auto pts = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), points_);
   auto lambdaT = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), tangentialMultipliers_);
@@ -157,7 +155,7 @@ void FrictionEffect::constraintRows(const NodalVectors&, ConstraintRows& rows) c
   const int nq = kernels::facePointCount(rule);
   const auto b = contact_.axisDirection();
   const double epsT = parameters_.tangentPenalty;
-  std::vector<double> grad;
+  grad.clear(), column.clear();
   for (size_t f = 0; f < pts.extent(0); ++f)
     for (int q = 0; q < nq; ++q) {
       if (int(pts(f, q, kState)) != 1) continue;
@@ -168,22 +166,45 @@ void FrictionEffect::constraintRows(const NodalVectors&, ConstraintRows& rows) c
       const double* e = &pts(f, q, kFE);
       const double tangents[2][3] = {{b[1] * e[2] - b[2] * e[1], b[2] * e[0] - b[0] * e[2], b[0] * e[1] - b[1] * e[0]},
                                      {b[0], b[1], b[2]}};
-      for (const auto& tau : tangents) {
+      for (int k = 0; k < 2; ++k) {
+        const double* tau = tangents[k];
         // The slip along tau, from the stick traction t = P_t lambda_T + du_t / eps_t.
         double slip = 0;
         for (int i = 0; i < 3; ++i) slip += epsT * tau[i] * (pts(f, q, kTraction + i) - lambdaT(m + i));
-        for (int a = 0; a < 4; ++a)
-          for (int i = 0; i < 3; ++i) grad.push_back(-N[a] * tau[i]);  // d(tau . du_t) / dx_a
+        const size_t at = grad.size();
+        grad.resize(at + width, 0.0), column.resize(at + width, 0.0);
+        fill(f, N, e, tau, k == 0, &grad[at]);
+        for (int a = 0; a < 4; ++a)  // dR/dmu = -w N_a tau on the face's nodes
+          for (int i = 0; i < 3; ++i) column[at + 3 * a + i] = -pts(f, q, kFWeight) * N[a] * tau[i];
         rows.entity.push_back(int(f)), rows.multiplier.push_back(m);
         rows.force.push_back(pts(f, q, kFWeight)), rows.diagonal.push_back(0.0);
         rows.value.push_back(slip), rows.schur.push_back(-epsT), rows.scale.push_back(0.0);
         rows.direction.insert(rows.direction.end(), tau, tau + 3);
       }
     }
-  rows.gradient = Matrix("stick dc/dx", rows.size(), 12);
-  auto h = Kokkos::create_mirror_view(rows.gradient);
-  for (size_t k = 0; k < grad.size(); ++k) h.data()[k] = grad[k];
-  Kokkos::deep_copy(rows.gradient, h);
+}
+
+Matrix FrictionEffect::rowMatrix(const char* label, size_t rows, int width, const std::vector<double>& values) {
+  Matrix m(std::string(label), rows, size_t(width));
+  auto h = Kokkos::create_mirror_view(m);
+  for (size_t k = 0; k < values.size(); ++k) h.data()[k] = values[k];
+  Kokkos::deep_copy(m, h);
+  return m;
+}
+
+void FrictionEffect::constraintRows(const NodalVectors&, ConstraintRows& rows) const {
+  rows.clear();
+  rows.gradient = Matrix();
+  if (!stepsForItself()) return;
+  std::vector<double> grad, column;
+  stickRows(
+      rows, 12,
+      [](size_t, const double N[4], const double*, const double tau[3], bool, double* g) {
+        for (int a = 0; a < 4; ++a)
+          for (int i = 0; i < 3; ++i) g[3 * a + i] = -N[a] * tau[i];  // d(tau . du_t) / dx_a
+      },
+      grad, column);
+  rows.gradient = rowMatrix("stick dc/dx", rows.size(), 12, grad);  // the columns are force x gradient
 }
 
 double FrictionEffect::constraintViolation() const {

@@ -5,6 +5,7 @@
 #include "../../kernels/friction.hpp"
 
 #include <array>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -100,6 +101,17 @@ class FrictionEffect : public Effect {
   Kokkos::View<double*> history_;
   Kokkos::View<double*> tangentialMultipliers_;  // [(face * kMaxFacePoints + q) * 3 + i]
   static constexpr int kHistoryPerFace = 12 + 3 * kernels::kMaxFacePoints;
+  // Coulomb's sticking points, two rows each (constraintRows): the value,
+  // multiplier, force, Schur diagonal and direction of each row into rows;
+  // fill(f, N, e, tau, circumferential, g) writes a row's gradient over the
+  // entity's `width` dofs into g (zeroed); grad and column get every row's
+  // gradient and dR/dmu (-w N_a tau on the face's nodes), row after row.
+  using StickRowFill =
+      std::function<void(size_t f, const double N[4], const double* e, const double tau[3], bool circumferential,
+                         double* g)>;
+  void stickRows(ConstraintRows& rows, int width, const StickRowFill& fill, std::vector<double>& grad,
+                 std::vector<double>& column) const;
+  static Matrix rowMatrix(const char* label, size_t rows, int width, const std::vector<double>& values);
   Points points_;
   FrictionSettings settings_;
   double dt_ = 0;  // the increment's length (setInterval)

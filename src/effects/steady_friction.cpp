@@ -209,71 +209,41 @@ void SteadyFrictionEffect::constraintRows(const NodalVectors& x, ConstraintRows&
   rows.clear();
   rows.gradient = Matrix();
   if (!stepsForItself() || !enabled_) return;
-  // On the host: the points of the nip only.
-  auto pts = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), points_);
-  auto lambdaT = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), tangentialMultipliers_);
   auto W = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), weights_);
   auto nodes = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), entityNodes_);
   auto xh = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), x);
-  const auto rule = contact_.rule();
-  const int nq = kernels::facePointCount(rule);
-  const auto b = contact_.axisDirection();
-  const double epsT = parameters_.tangentPenalty;
   const double omega = core_ >= 0 ? cores_->records()[core_].angularVelocity : 0.0;
   const double flow = sigma_ * axisSign_ * omega, dFlow = sigma_ * axisSign_;
   constexpr int nNode = 3 * kNodes;
   const int n = core_ >= 0 ? nNode + 3 : nNode;
   const double radius = contact_.radius();
   std::vector<double> grad, column;
-  for (size_t f = 0; f < pts.extent(0); ++f)
-    for (int q = 0; q < nq; ++q) {
-      if (int(pts(f, q, kState)) != 1) continue;
-      const int m = (int(f) * kernels::kMaxFacePoints + q) * 3;
-      double xi, eta, w, N[4], dN[4][2];
-      kernels::facePoint(rule, q, xi, eta, w);
-      kernels::quadShape(xi, eta, N, dN);
-      const double* e = &pts(f, q, kFE);
-      const double tangents[2][3] = {{b[1] * e[2] - b[2] * e[1], b[2] * e[0] - b[0] * e[2], b[0] * e[1] - b[1] * e[0]},
-                                     {b[0], b[1], b[2]}};
-      double travel[3] = {0, 0, 0};  // sum_a N_a tau_f (dx/dtheta)_a
-      for (int a = 0; a < 4; ++a)
-        for (int k = 0; k < kNodes; ++k)
-          for (int i = 0; i < 3; ++i) travel[i] += N[a] * W(f, a, k) * xh(nodes(f, k), i);
-      for (const auto& tau : tangents) {
-        double slip = 0;  // from the stick traction t = P_t lambda_T + du_t / eps_t
-        for (int i = 0; i < 3; ++i) slip += epsT * tau[i] * (pts(f, q, kTraction + i) - lambdaT(m + i));
-        const size_t at = grad.size();
-        grad.resize(at + n, 0.0), column.resize(at + n, 0.0);
+  stickRows(
+      rows, n,
+      [&](size_t f, const double N[4], const double* e, const double tau[3], bool circumferential, double* g) {
+        double travel[3] = {0, 0, 0};  // sum_a N_a tau_f (dx/dtheta)_a
         for (int k = 0; k < kNodes; ++k) {
           double NW = 0;
           for (int a = 0; a < 4; ++a) NW += N[a] * W(f, a, k);
-          for (int i = 0; i < 3; ++i) grad[at + 3 * k + i] -= flow * NW * tau[i];
+          for (int i = 0; i < 3; ++i) {
+            g[3 * k + i] -= flow * NW * tau[i];
+            travel[i] += NW * xh(nodes(f, k), i);
+          }
         }
-        if (core_ >= 0) grad[at + nNode] = -dFlow * (tau[0] * travel[0] + tau[1] * travel[1] + tau[2] * travel[2]);
+        if (core_ >= 0) g[nNode] = -dFlow * (tau[0] * travel[0] + tau[1] * travel[1] + tau[2] * travel[2]);
         // tau = b x e turns with the point (de/dx = (I - b b^T - e e^T) / d):
         // du^T dtau/dx = -(e . du) tau^T / d, with e . du = -flow e . travel
         // (the capstan's travel is tangent). The capstan's own travel, spin
         // (b x e), turns likewise but has no component along tau's change.
-        if (&tau == &tangents[0]) {
+        if (circumferential) {
           const double normalSlip = -flow * (e[0] * travel[0] + e[1] * travel[1] + e[2] * travel[2]);
           for (int a = 0; a < 4; ++a)
-            for (int i = 0; i < 3; ++i) grad[at + 3 * a + i] -= N[a] * normalSlip * tau[i] / radius;
+            for (int i = 0; i < 3; ++i) g[3 * a + i] -= N[a] * normalSlip * tau[i] / radius;
         }
-        for (int a = 0; a < 4; ++a)
-          for (int i = 0; i < 3; ++i) column[at + 3 * a + i] = -pts(f, q, kFWeight) * N[a] * tau[i];
-        rows.entity.push_back(int(f)), rows.multiplier.push_back(m);
-        rows.force.push_back(pts(f, q, kFWeight)), rows.diagonal.push_back(0.0);
-        rows.value.push_back(slip), rows.schur.push_back(-epsT), rows.scale.push_back(0.0);
-        rows.direction.insert(rows.direction.end(), tau, tau + 3);
-      }
-    }
-  rows.gradient = Matrix("steady stick dc/dx", rows.size(), n);
-  rows.column = Matrix("steady stick dR/dmu", rows.size(), n);
-  auto hg = Kokkos::create_mirror_view(rows.gradient);
-  auto hc = Kokkos::create_mirror_view(rows.column);
-  for (size_t k = 0; k < grad.size(); ++k) hg.data()[k] = grad[k], hc.data()[k] = column[k];
-  Kokkos::deep_copy(rows.gradient, hg);
-  Kokkos::deep_copy(rows.column, hc);
+      },
+      grad, column);
+  rows.gradient = rowMatrix("steady stick dc/dx", rows.size(), n, grad);
+  rows.column = rowMatrix("steady stick dR/dmu", rows.size(), n, column);
 }
 
 }  // namespace capstan
