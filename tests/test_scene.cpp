@@ -713,3 +713,13 @@ TEST(SolverSettings, PressureUpdateAutoByKind) {
   EXPECT_EQ(SolverSettings::defaults(true, true).pressureUpdate, P::SaddlePoint) << "quasi-static rolling";
   EXPECT_EQ(SolverSettings::defaults(true, false, true).pressureUpdate, P::SaddlePoint) << "steady rolling";
 }
+
+// Max Newton Iterations = 0: 60 for rolling with friction, quasi-static or
+// steady (their first solves crawl past 30 and converge), 30 otherwise.
+TEST(SolverSettings, MaxNewtonIterationsAutoByKind) {
+  EXPECT_EQ(SolverSettings::defaults(false).maxNewtonIterations, 30);
+  EXPECT_EQ(SolverSettings::defaults(true).maxNewtonIterations, 30) << "friction, no rolling";
+  EXPECT_EQ(SolverSettings::defaults(true, true).maxNewtonIterations, 60) << "quasi-static rolling";
+  EXPECT_EQ(SolverSettings::defaults(true, false, true).maxNewtonIterations, 60) << "steady rolling";
+  EXPECT_EQ(SolverSettings::defaults(false, false, true).maxNewtonIterations, 30) << "steady, frictionless";
+}
