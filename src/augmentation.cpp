@@ -31,6 +31,15 @@ constexpr double kLaterPassReduction = 1e-4;
 // the 3D drive the same 578 Newton iterations over 20 steps; 1 gave 631, the
 // absolute tolerance 656 (docs/friction.md).
 constexpr double kPolishBelow = 10;
+// A saddle-point step is halved (down to kShortestPressureStep) while the
+// momentum residual it leaves is above kPressureStepMerit x the step's starting
+// residual (|R| and the scaled constraint errors): its linear model holds only
+// while no point crosses between stick, slip and free. 1 took the steady 3D
+// drive from rest in 80 Newton iterations (125 without), each step of its brake
+// sweep in 8-15 (8-29); 0.5 gave the same, 2 and 3 most of the loss back
+// (docs/friction.md).
+constexpr double kPressureStepMerit = 1;
+constexpr double kShortestPressureStep = 1.0 / 16;
 
 json::Object eventOf(const char* name) { return json::Object().add("event", json::string(name)); }
 
@@ -234,19 +243,41 @@ bool AugmentationLoop::saddlePointPressureStep(double t, Vector& f, bool volumeM
                  .add("contact_rows", json::number(step.contactRows))
                  .add("seconds", json::number(since(stepStart))));
   if (!(step.reduction < 1)) return false;
-  m_.u->update(1.0, dx, 1.0);
-  assembly.applyConstraints(*m_.u, t);
-  // Each effect's multipliers move by their part of dmu (contact's back into
-  // lambda >= 0: a point the step pulls free is released).
-  for (size_t i = 0; i < assembly.effects().size(); ++i) {
-    Effect& e = *assembly.effects()[i];
-    auto mu = e.multipliers();
-    auto d = pressureStepDmu_[i];
-    if (mu.extent(0) == 0 || d.extent(0) != mu.extent(0)) continue;
-    Kokkos::parallel_for(
-        "pressure step multipliers", Kokkos::RangePolicy<ExecSpace>(0, mu.extent(0)),
-        KOKKOS_LAMBDA(int k) { mu(k) += d(k); });
-    e.projectMultipliers();
+  // The step's start, to scale it back from (the constraint rows are the
+  // last evaluation's, so the trial's merit is its momentum residual alone).
+  const Vector u0(*m_.u, Teuchos::Copy);
+  std::vector<Kokkos::View<double*>> mu0;
+  for (auto& e : assembly.effects()) {
+    auto mu = e->multipliers();
+    Kokkos::View<double*> copy("multipliers before the step", mu.extent(0));
+    Kokkos::deep_copy(copy, mu);
+    mu0.push_back(copy);
+  }
+  for (double alpha = 1;; alpha /= 2) {
+    m_.u->update(1.0, u0, alpha, dx, 0.0);
+    assembly.applyConstraints(*m_.u, t);
+    // Each effect's multipliers move by their part of dmu (contact's back into
+    // lambda >= 0: a point the step pulls free is released).
+    for (size_t i = 0; i < assembly.effects().size(); ++i) {
+      Effect& e = *assembly.effects()[i];
+      auto mu = e.multipliers();
+      auto d = pressureStepDmu_[i];
+      auto start = mu0[i];
+      if (mu.extent(0) == 0 || d.extent(0) != mu.extent(0)) continue;
+      Kokkos::parallel_for(
+          "pressure step multipliers", Kokkos::RangePolicy<ExecSpace>(0, mu.extent(0)),
+          KOKKOS_LAMBDA(int k) { mu(k) = start(k) + alpha * d(k); });
+      e.projectMultipliers();
+    }
+    if (alpha <= kShortestPressureStep) break;
+    const bool valid = assembly.evaluate(*m_.u, &f, nullptr);
+    const double left = f.norm2();  // collective: every rank
+    if (valid && left <= kPressureStepMerit * step.initial) break;
+    m_.pressureStep->shortened();
+    if (log_.on("newton"))
+      log_.event("newton", format("pressure step %.4g halved: it leaves |R| %.3e above %.3e", alpha, left, step.initial),
+                 eventOf("pressure_step_halved").add("length", json::number(alpha)).add("residual", json::number(left))
+                     .add("start", json::number(step.initial)));
   }
   return true;
 }

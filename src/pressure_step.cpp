@@ -402,6 +402,7 @@ PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv
     if (!progress) break;  // stagnated: keep what there is (the loop checks the outcome)
   }
   result.reduction = beta0 > 0 ? beta / beta0 : 0.0;
+  result.initial = beta0;
   lastPredicted_ = result.reduction < 1 ? result.volumePredicted : 0.0;  // a step without progress is not taken
   result.volumeResidual = volumeError(*r.c);
   // Held dofs stay where they are (K's identity rows would keep them at ~0

@@ -67,6 +67,7 @@ class PressureStep {
   struct Result {
     int iterations = 0;
     double reduction = 1;  // final / initial residual (both blocks, scaled)
+    double initial = 0;    // the initial residual's norm (|R| and the scaled constraint errors)
     double volumeResidual = 0;  // max_e |V_e - v_e - g_e.dx| / V_e: the volume error the step leaves (to first order)
     double volumePredicted = 0;  // > 0: stopped early on this volume error predicted after Newton's next solve
     double predictionTarget = 0; // the target the prediction had to meet (volumeTarget / the miss ratio)
@@ -97,6 +98,8 @@ class PressureStep {
   // of K^-1 (G1: ~1-1.4x; the Hertz roller 5-20x, which without the ratio
   // hovered above its volume tolerance pass after pass).
   void measuredAfterNewton(double volumeError);
+  // The last step was taken shortened: its prediction does not apply.
+  void shortened() { lastPredicted_ = 0; }
   // Constraint rows of the last solve (all ranks): volumes and contact points.
   long rows() const { return rows_; }
   double seconds() const { return seconds_; }

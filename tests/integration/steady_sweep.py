@@ -1,0 +1,42 @@
+#!/usr/bin/env python3
+"""A brake sweep of the 3D drive in one steady run (issue 31: each continuation step at
+most 20 Newton iterations, no cuts): inputs/pinch-roller-steady.xml with the brake torque
+ramped to 18 N mm (90% of mu F R) over 10 steps, as scripts/steady-bench.py runs it.
+
+  * 10 steps, no cut; every step after the first (the steady state from rest) at most 20
+    Newton iterations;
+  * the speed ratio falls with each torque step (more brake, more creep);
+  * the saddle-point step was shortened at least once (the merit test that keeps a step
+    from pushing points across stick, slip and free: src/augmentation.cpp), and every
+    shortening was called for (the longer step left |R| above the step's start).
+"""
+import os
+import sys
+
+sys.dont_write_bytecode = True
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from capstan_test import Test  # noqa: E402
+
+T = Test("steady_sweep", __doc__)
+scene = T.input("pinch-roller-steady.xml")
+sets = ["Supports/core/Torque=18", "Supports/core/Torque Ramp Time=0.010", "Time/Steps=10",
+        "Output/Write Fields=false"]
+_, s, out = T.run_scene(scene, "sweep", sets=sets, extra=["--log", "newton"])
+if s:
+    T.conforms(out, scene)
+    st = s["steps"]
+    newton = [x["newton_iterations"] for x in st]
+    cuts = [x["cutbacks"] for x in st]
+    ratio = [x["supports"]["core"]["speed_ratio"] for x in st]
+    print(f"    Newton per step {newton}, cuts {cuts}")
+    print("    speed ratio " + ", ".join(f"{r:.5f}" for r in ratio))
+    T.check(len(st) == 10, f"10 steps ({len(st)})")
+    T.check(sum(cuts) == 0, f"no step cut ({cuts})")
+    T.check(max(newton[1:]) <= 20, f"steps 2-10: at most 20 Newton iterations each ({max(newton[1:])})")
+    T.check(all(b < a for a, b in zip(ratio, ratio[1:])), "the speed ratio falls with the brake torque")
+    halved = T.log_events(out, "pressure_step_halved")
+    T.check(len(halved) > 0, f"the saddle-point step was shortened ({len(halved)} times)")
+    T.check(all(e["residual"] > e["start"] for e in halved), "each shortening: the longer step left |R| above the start")
+else:
+    T.check(False, "the sweep converges")
+T.finish()
