@@ -35,6 +35,9 @@ bool LoadStepper::advance(StepRecord& rec, std::string& failure) {
   const double tStep = tDone_;
   while (tDone_ < rec.time - 1e-12 * dt) {
     const double tEnd = std::min(tDone_ + h, rec.time);
+    // The cores' records from u: a failed attempt left them at its last trial,
+    // and the rotations saved here give the next sub-step's turn (Predictors).
+    assembly.applyConstraints(*m_.u, tDone_);
     Vector uSaved(*m_.u, Teuchos::Copy);
     const auto stateSaved = saveState(effects);
     std::vector<double> rotationsSaved;
