@@ -79,8 +79,8 @@ bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string
       tolIt = std::max(std::min(tol, kLaterPassReduction * passStart), 1e-3 * m_.absTolerance);
     }
     const auto solveStart = Clock::now();
-    // The solve's start, for a retry through wider friction laws (only kept
-    // where there is one).
+    // The solve's start, for a retry through wider friction laws or a smoothed
+    // stick/slip corner (only kept where there is one).
     const RCP<Vector> start = continuation_.applies() ? rcp(new Vector(*m_.u, Teuchos::Copy)) : Teuchos::null;
     // A later pass that starts near Newton's tolerance is polished by one
     // Newton step: Newton to 1e-3 x the absolute tolerance only stagnates where
@@ -93,8 +93,11 @@ bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string
     NewtonResult r = it > 1 && passStart <= polishBelow ? polish(t, passStart) : m_.newton->solve(*m_.u, tolIt);
     if (!r.converged && start) {
       if (log_.on("newton"))
-        log_.event("newton", format("newton failed (%s) in %d iterations: continuation in the friction "
-                                    "regularisation, %d stages", r.failure.c_str(), r.iterations, continuation_.stages()),
+        log_.event("newton", continuation_.regularised()
+                                 ? format("newton failed (%s) in %d iterations: continuation in the friction "
+                                          "regularisation, %d stages", r.failure.c_str(), r.iterations, continuation_.stages())
+                                 : format("newton failed (%s) in %d iterations: again through a smoothed stick/slip corner",
+                                          r.failure.c_str(), r.iterations),
                    eventOf("continuation").add("failed_iterations", json::number(r.iterations)));
       rec.newton += r.iterations;
       rec.linear += r.linearIterations;

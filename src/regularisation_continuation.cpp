@@ -14,6 +14,8 @@ RegularisationContinuation::RegularisationContinuation(const std::vector<Frictio
     if (f && f->travelOverSlipScale() > 0) {
       frictions_.push_back(f);
       ratio = std::max(ratio, f->travelOverSlipScale());
+    } else if (f && f->exactCorner()) {
+      corners_.push_back(f);
     }
   // 3^K about a third of the travel over v.
   if (ratio > 9) stages_ = int(std::ceil(std::log(ratio / 3) / std::log(3.0)));
@@ -25,9 +27,17 @@ void RegularisationContinuation::setScale(double scale) {
 
 // The short sequence's first power (see the header).
 constexpr int kShortSequence = 2;
+// The smoothed corner's width (Friction/Smoothing) for Coulomb's retry: 1e-2
+// took the 18 fast rollers (docs/friction.md) from 24 cuts to 9.
+constexpr double kCornerSmoothing = 1e-2;
 
 NewtonResult RegularisationContinuation::solve(NewtonSolver& newton, Vector& u, double tolerance) {
   NewtonResult total;
+  if (stages_ == 0) {
+    total.converged = cornerSequence(newton, u, tolerance, total);
+    if (!total.converged) total.failure = "continuation through a smoothed stick/slip corner failed: " + total.failure;
+    return total;
+  }
   const Vector start(u, Teuchos::Copy);
   bool converged = sequence(newton, u, tolerance, std::min(kShortSequence, stages_), total);
   if (!converged && stages_ > kShortSequence) {
@@ -44,21 +54,36 @@ bool RegularisationContinuation::sequence(NewtonSolver& newton, Vector& u, doubl
                                           NewtonResult& total) {
   for (int k = first; k >= 0; --k) {
     setScale(std::pow(3.0, k));
-    const NewtonResult r = newton.solve(u, tolerance);
-    if (log_.on("newton"))
-      log_.event("newton", format("regularisation x 3^%d: %s in %d Newton iterations, |R| %.3e", k,
-                                  r.converged ? "converged" : "failed", r.iterations, r.residualNorm),
-                 json::Object().add("event", json::string("regularisation_stage")).add("power", json::number(k))
-                     .add("converged", r.converged ? "true" : "false")
-                     .add("iterations", json::number(r.iterations)));
-    total.iterations += r.iterations;
-    total.linearIterations += r.linearIterations;
-    total.residualHistory.insert(total.residualHistory.end(), r.residualHistory.begin(), r.residualHistory.end());
-    total.residualNorm = r.residualNorm;
-    total.failure = r.failure;
-    if (!r.converged) return false;
+    if (!stage(newton, u, tolerance, format("regularisation x 3^%d", k), k, total)) return false;
   }
   return true;
+}
+
+bool RegularisationContinuation::cornerSequence(NewtonSolver& newton, Vector& u, double tolerance,
+                                                NewtonResult& total) {
+  for (auto* f : corners_) f->setCornerSmoothing(kCornerSmoothing);
+  const bool smoothed = stage(newton, u, tolerance, format("stick/slip corner smoothed by %g", kCornerSmoothing),
+                              -1, total);
+  for (auto* f : corners_) f->setCornerSmoothing(0);
+  return smoothed && stage(newton, u, tolerance, "exact stick/slip corner", -1, total);
+}
+
+bool RegularisationContinuation::stage(NewtonSolver& newton, Vector& u, double tolerance, const std::string& what,
+                                       int power, NewtonResult& total) {
+  const NewtonResult r = newton.solve(u, tolerance);
+  if (log_.on("newton")) {
+    auto event = json::Object().add("event", json::string("regularisation_stage")).add("stage", json::string(what));
+    if (power >= 0) event.add("power", json::number(power));
+    log_.event("newton", format("%s: %s in %d Newton iterations, |R| %.3e", what.c_str(),
+                                r.converged ? "converged" : "failed", r.iterations, r.residualNorm),
+               event.add("converged", r.converged ? "true" : "false").add("iterations", json::number(r.iterations)));
+  }
+  total.iterations += r.iterations;
+  total.linearIterations += r.linearIterations;
+  total.residualHistory.insert(total.residualHistory.end(), r.residualHistory.begin(), r.residualHistory.end());
+  total.residualNorm = r.residualNorm;
+  total.failure = r.failure;
+  return r.converged;
 }
 
 }  // namespace capstan

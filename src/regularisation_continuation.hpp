@@ -19,6 +19,14 @@
 // the whole sequence from where the solve started, 3^K about a third of the
 // travel over v: the first law smooth on the scale of the increment (H4's
 // first step and H5 at eps3 = 1e-5 need it).
+//
+// Coulomb with the exact stick/slip corner: a point whose trial traction sits
+// at the cone's edge (within 1e-7 on the fast rollers) gives Newton one side's
+// generalised Jacobian, along whose direction |R| can rise: the line search
+// fails after one good step, at |R| ~ 1e-4 of its start. A failed solve is
+// then repeated from its start with the corner smoothed (Friction/Smoothing =
+// kCornerSmoothing: stick tractions softened by about delta^2 / 4), and ends
+// with the exact corner from that answer.
 #pragma once
 
 #include <string>
@@ -35,8 +43,10 @@ class RegularisationContinuation {
  public:
   RegularisationContinuation(const std::vector<FrictionEffect*>& frictions, Log& log);
   // Whether a failed solve can be retried this way (some regularised law with
-  // travel over slip scale above 3).
-  bool applies() const { return stages_ > 0; }
+  // travel over slip scale above 3, or Coulomb with the exact corner).
+  bool applies() const { return stages_ > 0 || !corners_.empty(); }
+  // Whether it widens a regularised law (else: Coulomb's corner only).
+  bool regularised() const { return stages_ > 0; }
   // The solve through the stages from u (the failed solve's start, in place):
   // the short sequence, then if it fails the whole one. The iterations of
   // every stage are summed in the result.
@@ -47,7 +57,14 @@ class RegularisationContinuation {
   // Stages 3^first, ..., 3^0 from u; adds to `total`, false where one fails.
   bool sequence(NewtonSolver& newton, Vector& u, double tolerance, int first, NewtonResult& total);
   void setScale(double scale);
+  // Coulomb: the smoothed corner's solve, then the exact corner's from it.
+  bool cornerSequence(NewtonSolver& newton, Vector& u, double tolerance, NewtonResult& total);
+  // Adds a stage's solve to `total`; false where it failed.
+  // power >= 0: the regularisation's stage 3^power (logged as such).
+  bool stage(NewtonSolver& newton, Vector& u, double tolerance, const std::string& what, int power,
+             NewtonResult& total);
   std::vector<FrictionEffect*> frictions_;
+  std::vector<FrictionEffect*> corners_;  // Coulomb with the exact corner
   Log& log_;
   int stages_ = 0;
 };

@@ -22,6 +22,11 @@ class FrictionEffect : public Effect {
   // Tanh and Arctan: the slip scale v is eps3 dt x `scale` (1: the scene's
   // law; src/regularisation_continuation.hpp widens it for a failed solve).
   void setRegularisationScale(double scale);
+  // Coulomb with the exact stick/slip corner (Friction/Smoothing = 0): whether
+  // a failed solve may be retried through a smoothed corner, and that corner's
+  // width for the retry (0: the scene's own again; RegularisationContinuation).
+  bool exactCorner() const { return settings_.law == FrictionSettings::Law::Coulomb && settings_.smoothing == 0; }
+  void setCornerSmoothing(double delta) { parameters_.smoothing = delta; }
   // Tanh and Arctan: the capstan surface's travel over the slip scale v
   // (scale 1), (|omega| R + |velocity|) / eps3, independent of dt; 0 otherwise.
   double travelOverSlipScale() const;
