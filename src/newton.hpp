@@ -34,6 +34,20 @@ class NewtonSolver {
   // Solves R(u) = 0 from the initial guess u (updated in place) until
   // |R| <= tolerance.
   NewtonResult solve(Vector& u, double tolerance);
+  // Pseudo-transient continuation (Kelley and Keyes, SIAM J. Numer. Anal. 35,
+  // 1998) from u (updated in place) until |R| <= tolerance: Newton steps with
+  // D / dtau added to the tangent's diagonal (D = |diag W|), every step that
+  // neither inverts an element nor multiplies |R| by 10 accepted, dtau
+  // doubled after a step that kept |R| within 1.5x and did not turn back on
+  // the last one (a cycle across a kink), else halved. Small dtau follows the
+  // flow du/dtau = -D^-1 R(u),
+  // which moves along the unbalanced force rather than down |R|: it crosses a
+  // region where |R| rises on the way to the root, which Newton's line search
+  // cannot, and it stays stable where the tangent is indefinite (a soft body
+  // dragged by friction whose force grows faster than its support's; docs/
+  // friction.md, "What step 2 is"). Large dtau is Newton's step. A fallback
+  // for a failed solve (src/augmentation.cpp); stepLengths holds dtau.
+  NewtonResult pseudoTransient(Vector& u, double tolerance);
   // One linear solve W x = b with Newton's matrix W = matrix(), as the caller
   // assembled it, and the configured solver with a preconditioner of its own
   // (x: initial guess in, solution out), to the relative residual `tolerance`

@@ -14,6 +14,11 @@ to the scene's v, within the increment (no step cut).
     stuck: the study's failure): converges with no step cut, and its capstan force is
     Coulomb's (the stick/slip law with exact stick) within 0.5%, with the same number of
     sticking points;
+  * H4, all 4 steps, with Tanh and with Arctan (step 2 drags the block under the
+    capstan across a local minimum of |R|: no Newton solve, wider law or step cut
+    passes it): converges with no step cut, the log shows the pseudo-transient
+    continuation ran and converged (NewtonSolver::pseudoTransient), and the final
+    capstan force (full slip, where the laws agree) is Coulomb's within 1e-5;
   * steady rolling, the free slice (pinch-roller-slice-steady.xml) with Tanh at
     Regularization 1e-3 (exit 2 without the continuation): converges with no cut, its
     speed ratio within 1e-5 of Coulomb's (the scene's own law) and the same stick and
@@ -92,6 +97,21 @@ if tanh and coulomb:
     close(a["force"], b["force"], 5e-3, "h4 step 1: Tanh's capstan force against Coulomb's")
     T.check(a["stick_points"] == b["stick_points"],
             f"h4 step 1: sticking points, Tanh {a['stick_points']} and Coulomb {b['stick_points']}")
+
+# H4's four steps with the regularised laws, against Coulomb (which still cuts step 2).
+p, full, _ = T.run_scene(T.input("seed/h4.xml"), "h4 coulomb 4 steps")
+for law in ("Tanh", "Arctan"):
+    s, out = run("h4", [F + "Law=" + law], f"h4 {law.lower()} 4 steps")
+    if not s:
+        continue
+    ptc = [e for e in T.log_events(out) if e.get("event") == "pseudo_transient_end"]
+    T.check(any(e.get("converged") in (True, "true") for e in ptc),
+            f"h4 {law}: the pseudo-transient continuation ran and converged ({len(ptc)} logged)")
+    if full and full["converged"]:
+        close(s["steps"][-1]["capstans"]["capstan"]["force"], full["steps"][-1]["capstans"]["capstan"]["force"],
+              1e-5, f"h4 {law}: the final capstan force against Coulomb's")
+    else:
+        T.check(False, "h4 coulomb 4 steps: converged")
 
 # Steady rolling: the free slice with Tanh against Coulomb.
 scene = T.input("pinch-roller-slice-steady.xml")
