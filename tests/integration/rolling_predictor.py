@@ -87,19 +87,19 @@ else:
 # A failed attempt once left the cores' records at its last trial, so the next
 # sub-step's turn was measured from there: it pointed the wrong way, the shift was
 # refused, the body was rolled backwards and the sub-step failed again (the fast roller
-# at mu 0.3, 0.125 N, 2 cells per step: 158 Newton iterations per step and 35 cuts).
+# at mu 0.3, 0.125 N, 1 cell per step: 153 Newton iterations per step and 36 cuts).
 fast = T.input("free-roller-fast.xml")
-sets = ["Time/Step Size=0.008", "Time/Steps=8", "Capstans/capstan/Friction/Coefficient=0.3",
+sets = ["Time/Step Size=0.004", "Time/Steps=8", "Capstans/capstan/Friction/Coefficient=0.3",
         "Supports/core/Force={0, -0.125, 0}", NO_FIELDS]
 _, fr, out = T.run_scene(fast, "fast roller", sets=sets, extra=["--log", "newton"])
 if fr:
-    cuts = sum(s["cutbacks"] for s in fr["steps"])
+    cuts = sum(s["cutbacks"] for s in fr["steps"][2:])
     newton = [s["newton_iterations"] for s in fr["steps"]]
-    print(f"    fast roller: Newton per step {newton}, {cuts} cuts")
+    print(f"    fast roller: Newton per step {newton}, {cuts} cuts in steps 3-8")
     later = [e for e in T.log_events(out) if e.get("step", 0) >= 3 and
              e.get("event") in ("streamline_shift", "extrapolation", "rolled")]
     shifts = [e["angle"] for e in later if e["event"] == "streamline_shift"]
-    T.check(cuts > 0, f"the fast roller cuts steps ({cuts}): its sub-steps are what this checks")
+    T.check(cuts > 0, f"the fast roller cuts steps 3-8 ({cuts} cuts): their sub-steps are what this checks")
     T.check(len(shifts) == len(later) and len(shifts) >= 6 + cuts,
             f"fast roller, steps 3-8: every increment and sub-step starts from the streamline shift "
             f"({len(shifts)} shifts, {len(later) - len(shifts)} other predictors)")
