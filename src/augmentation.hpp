@@ -39,6 +39,9 @@ class AugmentationLoop {
   // Debugging aid: the assembled tangent against a central difference of the
   // residual along a random direction, logged (topic newton, or stdout).
   void checkTangent();
+  // At u (evaluated here): whether no contact point of any capstan sticks
+  // (every rank; false without friction).
+  bool everyPointSlips();
 
   Model& m_;
   Log& log_;

@@ -2,7 +2,7 @@
 """Rolling contact with friction, the study's H cases (formulation.md §6,
 inputs/seed/h1.xml ... h5.xml).
 
-  * every scene converges and conforms; effects are brick, the foundation, contact and
+  * every scene converges with no step cut and conforms; effects are brick, the foundation, contact and
     friction (each capstan's friction is its own effect); every step of every run is in
     equilibrium: the capstan's force equals the sum of the supports' forces (1e-8 of
     the largest);
@@ -43,6 +43,8 @@ def run(name, sets=(), tag=None):
         return None
     T.conforms(out, scene)
     T.check(not has_nan(s), f"{tag or name}: no NaN in summary.json")
+    cuts = sum(st["cutbacks"] for st in s["steps"])
+    T.check(cuts == 0, f"{tag or name}: no step cut ({cuts})")
     worst = 0.0
     for st in s["steps"]:
         cap = st["capstans"]["capstan"]["force"]

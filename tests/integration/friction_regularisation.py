@@ -18,7 +18,8 @@ to the scene's v, within the increment (no step cut).
     capstan across a local minimum of |R|: no Newton solve, wider law or step cut
     passes it): converges with no step cut, the log shows the pseudo-transient
     continuation ran and converged (NewtonSolver::pseudoTransient), and the final
-    capstan force (full slip, where the laws agree) is Coulomb's within 1e-5;
+    capstan force (full slip, where the laws agree) is Coulomb's within 1e-5; Coulomb
+    (the shipped h4.xml) converges with no cut through it too;
   * steady rolling, the free slice (pinch-roller-slice-steady.xml) with Tanh at
     Regularization 1e-3 (exit 2 without the continuation): converges with no cut, its
     speed ratio within 1e-5 of Coulomb's (the scene's own law) and the same stick and
@@ -98,8 +99,15 @@ if tanh and coulomb:
     T.check(a["stick_points"] == b["stick_points"],
             f"h4 step 1: sticking points, Tanh {a['stick_points']} and Coulomb {b['stick_points']}")
 
-# H4's four steps with the regularised laws, against Coulomb (which still cuts step 2).
-p, full, _ = T.run_scene(T.input("seed/h4.xml"), "h4 coulomb 4 steps")
+# H4's four steps with the regularised laws, against Coulomb, which reaches step 2's
+# full slip in pseudo-time too (its failed solve ended with every point slipping).
+p, full, fout = T.run_scene(T.input("seed/h4.xml"), "h4 coulomb 4 steps", extra=["--log", "newton"])
+if full:
+    cuts = sum(x["cutbacks"] for x in full["steps"])
+    ptc = [e for e in T.log_events(fout) if e.get("event") == "pseudo_transient_end"]
+    T.check(cuts == 0, f"h4 coulomb: no step cut ({cuts})")
+    T.check(any(e.get("converged") in (True, "true") for e in ptc),
+            f"h4 coulomb: the pseudo-transient continuation ran and converged ({len(ptc)} logged)")
 for law in ("Tanh", "Arctan"):
     s, out = run("h4", [F + "Law=" + law], f"h4 {law.lower()} 4 steps")
     if not s:

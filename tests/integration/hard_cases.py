@@ -6,7 +6,9 @@ physics reached in smaller steps (or with the default parameters where the case 
 changes a penalty). Each case must converge with no NaN, contact within its tolerance
 (max_penetration <= 5e-5 = 1e-4 h with the augmented Lagrangian; H1's penalty contact:
 below 2e-3), max_abs_volume_change < 1e-8, bounded Newton iterations (a per-case
-budget), and a final capstan force within 1e-4 relative of the reference.
+budget), and a final capstan force within 1e-4 relative of the reference (1e-2 where
+points stick on the soft foundation, k = 0.01: there the answer depends on the step to
+first order).
 
   * H5 (mu = 0.9), H4 (k = 0.1) and k = 0.01 (augmented Lagrangian, Coulomb);
   * H1 with Regularization = 1e-15 (an almost discontinuous friction law);
@@ -30,7 +32,12 @@ FINE_H = ["Time/Steps=16", "Time/Step Size=0.005"]
 CASES = [
     ("H5 mu = 0.9", "seed/h5.xml", [], FINE_H, 5e-5, 400),
     ("H4 k = 0.1", "seed/h4.xml", [], FINE_H, 5e-5, 3000),
-    ("H4 k = 0.01", "seed/h4.xml", [f"{FOUND}=0.01"], [f"{FOUND}=0.01"] + FINE_H, 5e-5, 5000),
+    # Points stick here, so the answer depends on the load path, to first order in the
+    # step: at dt = 0.02, 0.01, 0.005, 0.0025, 0.00125 (uncut) Fy = 1.11198, 1.10963,
+    # 1.10756, 1.10658, 1.10600, each halving moving it about half as far as the last.
+    # Its tolerance is that path error between 0.02 and the reference's 0.005 (4.0e-3):
+    # within 1e-2. (Runs that cut step 2 down to 1/64 met the reference to 1e-4.)
+    ("H4 k = 0.01", "seed/h4.xml", [f"{FOUND}=0.01"], [f"{FOUND}=0.01"] + FINE_H, 5e-5, 5000, 1e-2),
     # Reference: the default eps3 = 1e-3 (H3: the answer does not depend on it). With
     # eps3 = 1e-15 in steps of 0.005 the first step does not converge (a point whose
     # slip passes through zero meets a friction law that is a step function).
@@ -55,7 +62,8 @@ def run(tag, scene, sets):
     return s
 
 
-for i, (name, scene, sets, ref_sets, pen_tol, budget) in enumerate(CASES):
+for i, (name, scene, sets, ref_sets, pen_tol, budget, *rest) in enumerate(CASES):
+    force_tol = rest[0] if rest else 1e-4
     s = run(f"case{i}", scene, sets)
     ref = run(f"case{i}-ref", scene, ref_sets)
     if s is None or ref is None:
@@ -75,5 +83,6 @@ for i, (name, scene, sets, ref_sets, pen_tol, budget) in enumerate(CASES):
     T.check(pen <= pen_tol, f"{name}: max_penetration {pen:.2e} <= {pen_tol:.0e}")
     T.check(dv < 1e-8, f"{name}: max_abs_volume_change {dv:.1e} < 1e-8")
     T.check(newton <= budget, f"{name}: {newton} Newton iterations <= {budget}")
-    T.check(diff <= 1e-4, f"{name}: final capstan force within {diff:.1e} (<= 1e-4) of the finely stepped reference")
+    T.check(diff <= force_tol, f"{name}: final capstan force within {diff:.1e} (<= {force_tol:.0e}) of the finely "
+            f"stepped reference")
 T.finish()
