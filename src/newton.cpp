@@ -506,11 +506,11 @@ int NewtonSolver::linearSolve(const Vector& b, Vector& x, double tolerance) {
   Kokkos::Timer timer;
   RCP<const Thyra::LinearOpBase<double>> W = impl_->W;
   auto space = impl_->model->get_x_space();
-  auto lows = Thyra::linearOpWithSolve(*impl_->lows, W);
   auto bt = Thyra::createConstVector(Teuchos::rcpFromRef(b), space);
   auto xt = Thyra::createVector(Teuchos::rcpFromRef(x), space);
   int iterations = -1;
-  try {
+  try {  // the factorisation (a direct solver's) happens here, and fails on a singular W
+    auto lows = Thyra::linearOpWithSolve(*impl_->lows, W);
     Thyra::SolveCriteria<double> criteria;
     criteria.solveMeasureType = Thyra::SolveMeasureType(Thyra::SOLVE_MEASURE_NORM_RESIDUAL, Thyra::SOLVE_MEASURE_NORM_RHS);
     criteria.requestedTol = tolerance;
@@ -652,7 +652,7 @@ NewtonResult NewtonSolver::pseudoTransient(Vector& u, double tolerance) {
   }
   r.residualNorm = norm;
   r.converged = valid && std::isfinite(norm) && norm <= tolerance;
-  if (!r.converged)
+  if (!r.converged && r.failure.empty())
     r.failure = r.iterations >= kPseudoTimeIterations ? "pseudo-transient continuation: iteration limit reached"
                                                        : "pseudo-transient continuation failed";
   assembly.evaluate(u, nullptr, nullptr);  // the effects' state at u
