@@ -91,7 +91,9 @@ bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string
     // at converged states: there only passes within the absolute tolerance
     // (the steady slice under Tanh stalled at 100 passes with 10x Newton's).
     NewtonResult r = it > 1 && passStart <= polishBelow ? polish(t, passStart) : m_.newton->solve(*m_.u, tolIt);
-    if (!r.converged && continuation_.applies()) {
+    // (Coulomb's corner retry not after a saddle-point step: undoing the step
+    // is the remedy there, below.)
+    if (!r.converged && continuation_.applies() && (continuation_.regularised() || !beforeStep)) {
       if (log_.on("newton"))
         log_.event("newton", continuation_.regularised()
                                  ? format("newton failed (%s) in %d iterations: continuation in the friction "
