@@ -10,6 +10,8 @@ inputs/seed/h1.xml ... h5.xml).
     reaction (1e-8 relative), and the integral of the friction traction equals mu times
     the integral of the normal traction (1e-6: friction fully mobilised), every contact
     point slipping;
+  * H1 with exact contact, Tanh and Coulomb: contact met to 1e-6 of
+    the capstan's radius, friction = mu x normal traction to 1e-8 in steps 2-4 (full slip);
   * H1 (tanh) and H2 (arctan) agree within 1% on the final capstan force and the xmin
     mean displacement;
   * H3: Regularization 1e-15, 1e-9, 1e-3, 1: every run converges, and the final capstan
@@ -97,6 +99,20 @@ if h1:
 
 if h1:
     check_power("H1", h1, (2, 3, 4))
+
+# H1 with exact contact (augmented Lagrangian), the study's Tanh and Coulomb: no cut,
+# contact met to 1e-6 of the capstan's radius, and in full slip friction = mu x normal
+# traction to 1e-8. (Arctan saturates only as 1 - 2 eps / (pi v): 2.5e-5 below here.)
+for law in ("Tanh", "Coulomb"):
+    s = run("h1", ["Capstans/capstan/Contact/Method=Augmented Lagrangian", f"{F}Law={law}"], tag=f"h1 exact {law}")
+    if not s:
+        continue
+    pen = max(st["capstans"]["capstan"]["max_penetration"] for st in s["steps"])
+    T.check(pen <= 1e-6 * 2.0, f"H1 exact {law}: max_penetration {pen:.1e} <= 1e-6 R")
+    worst = max(abs(st["capstans"]["capstan"]["friction"]["traction_integral"] /
+                    (0.1 * st["capstans"]["capstan"]["friction"]["normal_traction_integral"]) - 1)
+                for st in s["steps"][1:])
+    T.check(worst <= 1e-8, f"H1 exact {law}: friction / (mu x normal) - 1 = {worst:.1e} (<= 1e-8), steps 2-4")
 
 h2 = run("h2")
 if h1 and h2:
