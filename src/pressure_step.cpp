@@ -109,8 +109,13 @@ void PressureStep::fillRows() {
       rowStart_.push_back(cols_.size());
     }
   }
-  // Refilled in place while the pattern holds (no contact point came or went).
-  const bool same = !lastRowStart_.empty() && rowStart_ == lastRowStart_ && cols_ == lastCols_;
+  // Refilled in place while the pattern holds (no contact point came or went)
+  // on every rank: fillComplete on a new graph is collective (its column map)
+  // and on a refilled one is not, so a rank alone in a new pattern waited
+  // forever for the others (the 126k-dof steady drive on 2 ranks).
+  int sameHere = !lastRowStart_.empty() && rowStart_ == lastRowStart_ && cols_ == lastCols_, sameEverywhere = 0;
+  Teuchos::reduceAll(*comm, Teuchos::REDUCE_MIN, sameHere, Teuchos::outArg(sameEverywhere));
+  const bool same = sameEverywhere > 0;
   if (same) {
     gradient_->resumeFill();
   } else {
