@@ -3,7 +3,7 @@
 (inputs/pinch-roller-braked.xml, the 1 mm plane-strain slice), and a table of a
 finished pinch-roller run's figures per step.
 
-    scripts/pinch-roller-study.py [--out out/pinch-study] [--torques 0,0.15,...] [--steps 12]
+    scripts/pinch-roller-study.py [--out out/pinch-study] [--torques 0,0.15,...] [--steps 48]
     scripts/pinch-roller-study.py --figures out/pinch-roller/summary.json
 
 The brake study runs one scene per torque (runs whose summary.json exists are reused),
@@ -22,7 +22,7 @@ root = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
 ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
 ap.add_argument("--out", default="out/pinch-study")
 ap.add_argument("--torques", default="0,0.15,0.3,0.45,0.6,0.8,1.0,1.5")
-ap.add_argument("--steps", type=int, default=12)
+ap.add_argument("--steps", type=int, default=48)
 ap.add_argument("--capstan", default=os.path.join(root, "build", "capstan"))
 ap.add_argument("--figures", help="print the per-step table of this summary.json and stop")
 args = ap.parse_args()
