@@ -267,9 +267,29 @@ void MumpsSolver::analyse(const CrsMatrix& A) {
     id.jcn_loc = m.jcn.data();
     id.a_loc = m.a.data();
   }
-  switch (options_.ordering) {
+  if (options_.ordering == MumpsOptions::Ordering::Auto) {
+    // Both analysed, the one whose factorisation the analysis estimates at
+    // fewer flops (RINFOG(1)) kept: QAMD first (the cheaper analysis), then
+    // METIS, and QAMD again only where it won.
+    const double qamd = analyseWith(MumpsOptions::Ordering::Qamd);
+    const double metis = analyseWith(MumpsOptions::Ordering::Metis);
+    if (qamd < metis) analyseWith(MumpsOptions::Ordering::Qamd);
+  } else {
+    analyseWith(options_.ordering);
+  }
+  analysed_ = true;
+  ++numAnalyses_;
+  analysisSeconds_ = MPI_Wtime() - t0;
+}
+
+double MumpsSolver::analyseWith(MumpsOptions::Ordering ordering) {
+  Impl& m = *impl_;
+  DMUMPS_STRUC_C& id = m.id;
+  id.perm_in = nullptr;
+  switch (ordering) {
+    case MumpsOptions::Ordering::Auto:  // analyse() resolves it
     case MumpsOptions::Ordering::Metis:
-      computeMetisOrdering();
+      computeMetisOrdering();  // collective
       ICNTL(id, 7) = 1;
       id.perm_in = m.permIn.data();
       break;
@@ -279,9 +299,7 @@ void MumpsSolver::analyse(const CrsMatrix& A) {
     case MumpsOptions::Ordering::Qamd: ICNTL(id, 7) = 6; break;
   }
   call(1, "analysis");
-  analysed_ = true;
-  ++numAnalyses_;
-  analysisSeconds_ = MPI_Wtime() - t0;
+  return id.rinfog[0];  // the factorisation's estimated flops (broadcast by run())
 }
 
 // METIS_NodeND on the graph of A + A^T (no diagonal), on rank 0 from the
@@ -413,7 +431,7 @@ void MumpsSolver::run(int job) {
     dmumps_c(&m.id);
   }
   // Host only: the other ranks learn the outcome (and the figures) from rank 0.
-  if (m.hostOnly) MPI_Bcast(m.id.infog, 80, MPI_INT, 0, m.comm);
+  if (m.hostOnly) MPI_Bcast(m.id.infog, 80, MPI_INT, 0, m.comm), MPI_Bcast(m.id.rinfog, 40, MPI_DOUBLE, 0, m.comm);
 }
 
 std::int64_t MumpsSolver::factorEntries() const {
@@ -425,5 +443,6 @@ std::int64_t MumpsSolver::factorEntries() const {
 int MumpsSolver::peakMemoryMB() const { return impl_ ? INFOG(impl_->id, 21) : 0; }
 int MumpsSolver::totalMemoryMB() const { return impl_ ? INFOG(impl_->id, 22) : 0; }
 int MumpsSolver::orderingUsed() const { return impl_ ? INFOG(impl_->id, 7) : -1; }
+double MumpsSolver::estimatedFlops() const { return impl_ ? impl_->id.rinfog[0] : 0.0; }
 
 }  // namespace capstan

@@ -39,8 +39,13 @@ struct MumpsOptions {
   // with any of them (Metis' includes gathering the pattern and METIS_NodeND).
   // The factorisation is BLAS-bound: with OpenBLAS (one thread) in place of the
   // reference BLAS, Metis 3.8 s, Pord 5.4 s, AMF 7.8 s (2 ranks, Metis: 2.3 s).
-  enum class Ordering { Metis, Pord, Amd, Amf, Qamd };
-  Ordering ordering = Ordering::Metis;
+  // Auto (the default): METIS and QAMD both analysed, the one the analysis
+  // estimates at fewer factorisation flops kept. The 3D drive (4,806
+  // unknowns, a thin ring): QAMD 1.38e8 flops against METIS 2.03e8, 8% less
+  // time per Newton iteration; the Hertz ring (15,126): METIS 8.4e8 against
+  // 1.07e9 (docs/performance.md, "Linear solvers").
+  enum class Ordering { Auto, Metis, Pord, Amd, Amf, Qamd };
+  Ordering ordering = Ordering::Auto;
   // ICNTL(14): percentage by which the working space may grow over the
   // analysis' estimate (delayed pivots); < 0 keeps MUMPS' default. On
   // INFOG(1) = -8 or -9 it is raised and the factorisation retried once.
@@ -99,6 +104,7 @@ class MumpsSolver {
   int totalMemoryMB() const;
   // The ordering MUMPS used (INFOG(7): 0 AMD, 1 given (Metis here), 2 AMF, 4 PORD, 6 QAMD).
   int orderingUsed() const;
+  double estimatedFlops() const;  // the last analysis' estimate for one factorisation (RINFOG(1))
 
   // Wall times of the last analysis (with the pattern gathering and METIS),
   // factorisation and solve (with the gather and scatter), in seconds.
@@ -113,6 +119,7 @@ class MumpsSolver {
   bool extractPattern(const CrsMatrix& A);  // true if this rank's pattern changed
   void analyse(const CrsMatrix& A);
   void computeMetisOrdering();
+  double analyseWith(MumpsOptions::Ordering ordering);  // one analysis; returns its estimated flops
   void runFactorization();
   void call(int job, const char* phase);
 

@@ -122,7 +122,8 @@ class MumpsInverseOp : public Thyra::LinearOpBase<double> {
 };
 
 const std::vector<std::pair<const char*, MumpsOptions::Ordering>> kOrderings = {
-    {"Metis", MumpsOptions::Ordering::Metis}, {"Pord", MumpsOptions::Ordering::Pord},
+    {"Auto", MumpsOptions::Ordering::Auto},   {"Metis", MumpsOptions::Ordering::Metis},
+    {"Pord", MumpsOptions::Ordering::Pord},
     {"AMD", MumpsOptions::Ordering::Amd},     {"AMF", MumpsOptions::Ordering::Amf},
     {"QAMD", MumpsOptions::Ordering::Qamd}};
 
@@ -132,8 +133,9 @@ RCP<const Teuchos::ParameterList> validMumpsOptions() {
   static RCP<Teuchos::ParameterList> valid;
   if (valid.is_null()) {
     valid = Teuchos::parameterList("MUMPS");
-    valid->set("Ordering", std::string("Metis"),
-               "Fill-reducing ordering: Metis (METIS_NodeND, computed by capstan) | Pord | AMD | AMF | QAMD "
+    valid->set("Ordering", std::string("Auto"),
+               "Fill-reducing ordering: Auto (Metis and QAMD analysed, the fewer estimated flops kept) | Metis "
+               "(METIS_NodeND, computed by capstan) | Pord | AMD | AMF | QAMD "
                "(src/direct_solver.hpp has the measurements)");
     valid->set("Verbose", false, "MUMPS' own printing");
     valid->set("Scaling", false, "Row and column scaling before each factorisation (MUMPS' automatic choice)");

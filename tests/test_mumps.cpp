@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -201,6 +202,32 @@ TEST(Mumps, EveryOrderingSolves) {
     EXPECT_EQ(solver.orderingUsed(), infog7);
     solveAndCheck(solver, *A, 2);
   }
+}
+
+// Auto analyses with METIS and QAMD and keeps the one whose factorisation the
+// analysis estimates at fewer flops.
+TEST(Mumps, AutoOrderingKeepsTheFewerEstimatedFlops) {
+  auto A = convectionDiffusion(contiguousMap(N, worldComm()), ConvDiff{});
+  using O = MumpsOptions::Ordering;
+  std::map<int, double> flops;  // INFOG(7) -> estimate
+  for (O ordering : {O::Metis, O::Qamd}) {
+    MumpsOptions options = testOptions();
+    options.ordering = ordering;
+    MumpsSolver solver(options);
+    solver.factor(*A);
+    flops[solver.orderingUsed()] = solver.estimatedFlops();
+  }
+  ASSERT_EQ(flops.size(), 2u);
+  ASSERT_NE(flops[1], flops[6]) << "the two orderings must differ for the check to mean anything";
+  MumpsOptions options = testOptions();
+  options.ordering = O::Auto;
+  MumpsSolver solver(options);
+  solver.factor(*A);
+  const int expected = flops[1] < flops[6] ? 1 : 6;
+  EXPECT_EQ(solver.orderingUsed(), expected) << "METIS " << flops[1] << " flops, QAMD " << flops[6];
+  EXPECT_DOUBLE_EQ(solver.estimatedFlops(), std::min(flops[1], flops[6]));
+  EXPECT_EQ(solver.numAnalyses(), 1);
+  solveAndCheck(solver, *A, 2);
 }
 
 TEST(Mumps, RefactorisationWithTheSamePatternReusesTheAnalysis) {
