@@ -61,11 +61,13 @@ struct MumpsOptions {
   bool scaling = false;
   // Matrices with fewer rows than this are gathered onto rank 0 and factored
   // there alone (MUMPS on a communicator of one, centralised input); larger
-  // ones are factored by all ranks. On a few thousand unknowns a factorisation
-  // shared by two ranks is dominated by their messages: the 3D drive (4,800
-  // unknowns) took 64 ms a Newton iteration on 2 ranks against 31 ms on one
-  // (docs/performance.md, "Linear solvers"). 0: always all ranks.
-  long hostOnlyBelow = 20000;
+  // ones are factored by all ranks. Time per Newton iteration on 2 ranks,
+  // rank 0 alone against both (docs/performance.md, "Linear solvers"): the
+  // slice (1,926 unknowns) 6.2-6.8 against 7.1-7.4 ms, G1 1x (1,575) 11.5-11.8
+  // against 9.4-9.6 ms, the 3D drive (4,806) 26.1-27.3 against 17.3-19.1 ms
+  // (1 rank: 27.1), the Hertz ring (15,126) 131-143 against 93-99 ms (1 rank:
+  // 150). Below 2,000 it goes either way by up to 20%. 0: always all ranks.
+  long hostOnlyBelow = 2000;
 };
 
 class MumpsSolver {
