@@ -273,7 +273,9 @@ void MumpsSolver::analyse(const CrsMatrix& A) {
     // METIS, and QAMD again only where it won.
     const double qamd = analyseWith(MumpsOptions::Ordering::Qamd);
     const double metis = analyseWith(MumpsOptions::Ordering::Metis);
-    if (qamd < metis) analyseWith(MumpsOptions::Ordering::Qamd);
+    int qamdWins = qamd < metis;
+    MPI_Bcast(&qamdWins, 1, MPI_INT, 0, impl_->comm);  // rank 0's figures decide, for every rank alike
+    if (qamdWins) analyseWith(MumpsOptions::Ordering::Qamd);
   } else {
     analyseWith(options_.ordering);
   }
