@@ -88,6 +88,29 @@ VELOCITY = np.array([0.0, -0.1, 0.0])
 STEPS = 5
 
 
+def ensure_getfem():
+    """Installs Debian's python3-getfem on demand (apt-get, as root or through sudo);
+    exits 1 with the reason where it cannot."""
+    try:
+        import getfem  # noqa: F401
+        return
+    except ImportError:
+        pass
+    sudo = [] if os.geteuid() == 0 else ["sudo"]
+    print("GetFEM missing: installing Debian's python3-getfem", file=sys.stderr, flush=True)
+    ok = subprocess.run(sudo + ["apt-get", "install", "-y", "-qq", "python3-getfem"],
+                        env=dict(os.environ, DEBIAN_FRONTEND="noninteractive")).returncode == 0
+    if not ok:
+        ok = (subprocess.run(sudo + ["apt-get", "update", "-qq"]).returncode == 0 and
+              subprocess.run(sudo + ["apt-get", "install", "-y", "-qq", "python3-getfem"],
+                             env=dict(os.environ, DEBIAN_FRONTEND="noninteractive")).returncode == 0)
+    try:
+        import getfem  # noqa: F401
+    except ImportError:
+        sys.exit("getfem-g1.py: python3-getfem is not installed and apt-get could not install it "
+                 "(run as root, or with sudo, on Debian bookworm)")
+
+
 def solve_getfem(refine, rtol=1e-10, atol=None, r_aug=1e3, max_iter=40, check=False,
                  verbose=True):
     import getfem as gf
@@ -296,6 +319,7 @@ def main():
                          "LD_LIBRARY_PATH of both codes (e.g. an extracted "
                          "libopenblas0-serial); default: the system's BLAS alternative")
     args = ap.parse_args()
+    ensure_getfem()
     if args.blas_dir and not args.compare and os.environ.get("G1_BLAS_SET") != "1":
         env = child_env(args.blas_dir)
         env["G1_BLAS_SET"] = "1"
