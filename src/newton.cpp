@@ -597,6 +597,22 @@ NewtonResult NewtonSolver::pseudoTransient(Vector& u, double tolerance) {
   const RCP<FEMatrix> W = matrix();
   NewtonResult r;
   double dtau = kPseudoTimeStart;
+  // 1 on the free rows, 0 on the held ones (their unit diagonal and their
+  // positions stay), and where each row's diagonal sits in W's values.
+  Kokkos::View<double*> freeRow("free rows", dx.getLocalLength());
+  {
+    auto h = Kokkos::create_mirror_view(freeRow);
+    for (LO i = 0; i < LO(h.extent(0)); ++i) h(i) = assembly.ownedConstrained(i) ? 0.0 : 1.0;
+    Kokkos::deep_copy(freeRow, h);
+  }
+  Kokkos::View<size_t*> diagonalAt("diagonal offsets", dx.getLocalLength());
+  {
+    Teuchos::ArrayRCP<size_t> offsets;
+    W->getLocalDiagOffsets(offsets);
+    auto h = Kokkos::create_mirror_view(diagonalAt);
+    for (LO i = 0; i < LO(h.extent(0)); ++i) h(i) = offsets[i];
+    Kokkos::deep_copy(diagonalAt, h);
+  }
   bool valid = assembly.evaluate(u, &f, nullptr);
   double norm = f.norm2();  // collective: every rank
   r.residualHistory.push_back(norm);
@@ -606,16 +622,17 @@ NewtonResult NewtonSolver::pseudoTransient(Vector& u, double tolerance) {
     // W + |diag W| / dtau on the free rows (a held row's unit diagonal stays).
     W->getLocalDiagCopy(diag);
     {
-      Teuchos::ArrayRCP<size_t> offsets;
-      W->getLocalDiagOffsets(offsets);
-      auto d = diag.getData();
+      auto d = Kokkos::subview(diag.getLocalViewDevice(Tpetra::Access::ReadOnly), Kokkos::ALL(), 0);
       W->beginModify();
       auto local = W->getLocalMatrixDevice();
-      auto values = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), local.values);
-      auto rows = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), local.graph.row_map);
-      for (LO i = 0; i < LO(d.size()); ++i)
-        if (!assembly.ownedConstrained(i)) values(rows(i) + offsets[i]) += std::fabs(d[i]) / dtau;
-      Kokkos::deep_copy(local.values, values);
+      auto values = local.values;
+      auto rows = local.graph.row_map;
+      const double shift = 1 / dtau;
+      Kokkos::parallel_for(
+          "pseudo-time shift", Kokkos::RangePolicy<ExecSpace>(0, freeRow.extent(0)), KOKKOS_LAMBDA(int i) {
+            values(rows(i) + diagonalAt(i)) += freeRow(i) * (d(i) < 0 ? -d(i) : d(i)) * shift;
+          });
+      Kokkos::fence();
       W->endModify();
     }
     dx.putScalar(0.0);
@@ -627,9 +644,11 @@ NewtonResult NewtonSolver::pseudoTransient(Vector& u, double tolerance) {
     }
     r.linearIterations += linear;
     {
-      auto step = dx.getDataNonConst();
-      for (LO i = 0; i < LO(step.size()); ++i)
-        if (assembly.ownedConstrained(i)) step[i] = 0;  // the supports stay where u holds them
+      auto step = Kokkos::subview(dx.getLocalViewDevice(Tpetra::Access::ReadWrite), Kokkos::ALL(), 0);
+      Kokkos::parallel_for(  // the supports stay where u holds them
+          "held rows stay", Kokkos::RangePolicy<ExecSpace>(0, freeRow.extent(0)),
+          KOKKOS_LAMBDA(int i) { step(i) *= freeRow(i); });
+      Kokkos::fence();
     }
     trial.update(1.0, u, -1.0, dx, 0.0);
     const bool trialValid = assembly.evaluate(trial, &f, nullptr);
