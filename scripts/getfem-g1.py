@@ -97,13 +97,13 @@ def ensure_getfem():
     except ImportError:
         pass
     sudo = [] if os.geteuid() == 0 else ["sudo"]
+    env = dict(os.environ, DEBIAN_FRONTEND="noninteractive")
+
+    def apt(*words):
+        return subprocess.run(sudo + ["apt-get", *words, "-qq"], env=env).returncode == 0
+
     print("GetFEM missing: installing Debian's python3-getfem", file=sys.stderr, flush=True)
-    ok = subprocess.run(sudo + ["apt-get", "install", "-y", "-qq", "python3-getfem"],
-                        env=dict(os.environ, DEBIAN_FRONTEND="noninteractive")).returncode == 0
-    if not ok:
-        ok = (subprocess.run(sudo + ["apt-get", "update", "-qq"]).returncode == 0 and
-              subprocess.run(sudo + ["apt-get", "install", "-y", "-qq", "python3-getfem"],
-                             env=dict(os.environ, DEBIAN_FRONTEND="noninteractive")).returncode == 0)
+    apt("install", "-y", "python3-getfem") or (apt("update") and apt("install", "-y", "python3-getfem"))
     try:
         import getfem  # noqa: F401
     except ImportError:

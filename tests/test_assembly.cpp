@@ -403,12 +403,15 @@ using test::StepCheck;
 // A box under a capstan that presses its top face (exact contact), with the
 // capstan's friction law, solved by the saddle-point step at the box's field
 // state, over the increment (0, dt): tests/pressure_step_check.hpp.
-StepCheck checkStepOnPressedBox(const FrictionSettings& friction, double dt) {
+// The capstan's axis (along z) and radius: it presses the box's top face 0.08 deep.
+constexpr double kPressAxisX = 1.1, kPressAxisY = 1 + 1 - 0.08, kPressRadius = 1;
+
+Scene pressedBoxScene(const FrictionSettings& friction) {
   Scene scene = boxScene();
   CapstanSpec cap;
   cap.name = "capstan";
-  cap.radius = 1;
-  cap.axisPoint = {1.1, 1 + 1 - 0.08, 0}, cap.axisDirection = {0, 0, 1};
+  cap.radius = kPressRadius;
+  cap.axisPoint = {kPressAxisX, kPressAxisY, 0}, cap.axisDirection = {0, 0, 1};
   cap.angularVelocity = 1;
   cap.contactFaces = {"ymax"};
   cap.contact.method = ContactSettings::Method::AugmentedLagrangian;
@@ -417,7 +420,11 @@ StepCheck checkStepOnPressedBox(const FrictionSettings& friction, double dt) {
   cap.contact.quadrature = ContactSettings::Quadrature::Nodal;  // as exact contact requires
   cap.friction = friction;
   scene.capstans = {cap};
-  BoxProblem problem(scene, 0.3);
+  return scene;
+}
+
+StepCheck checkStepOnPressedBox(const FrictionSettings& friction, double dt) {
+  BoxProblem problem(pressedBoxScene(friction), 0.3);
   auto& [sc, mesh, assembly, newton, u, f] = problem;
   assembly.setInterval(0.0, dt);
   auto W = newton.matrix();
@@ -471,19 +478,7 @@ TEST(PressureStep, MovesStickTractionsWithTheVolumes) {
 // Deciding per rank deadlocked the 126k-dof steady drive on 2 ranks. (Under
 // the bug this test hangs; ctest's timeout fails it.)
 TEST(PressureStep, ContactPatternChangingOnOneRankOnly) {
-  Scene scene = boxScene();
-  CapstanSpec cap;
-  cap.name = "capstan";
-  cap.radius = 1;
-  const double axisX = 1.1, axisY = 1 + 1 - 0.08;
-  cap.axisPoint = {axisX, axisY, 0}, cap.axisDirection = {0, 0, 1};
-  cap.contactFaces = {"ymax"};
-  cap.contact.method = ContactSettings::Method::AugmentedLagrangian;
-  cap.contact.penalty = 1e-2, cap.contact.maxAugmentations = 50;
-  cap.contact.minimumSolvePenalty = -1;
-  cap.contact.quadrature = ContactSettings::Quadrature::Nodal;
-  scene.capstans = {cap};
-  BoxProblem problem(scene, 0.3);
+  BoxProblem problem(pressedBoxScene(FrictionSettings()), 0.3);
   auto& [sc, mesh, assembly, newton, u, f] = problem;
   auto W = newton.matrix();
   PressureStep step(assembly);
@@ -514,7 +509,7 @@ TEST(PressureStep, ContactPatternChangingOnOneRankOnly) {
     if (std::fabs(X[1] - 1) > 1e-12) continue;
     const bool zEdge = X[2] < 1e-12 || X[2] > 1.5 - 1e-12;
     const double x = X[0] + ud[3 * n], y = X[1] + ud[3 * n + 1];
-    if (leaving < 0 && zEdge && std::hypot(x - axisX, y - axisY) < 1 - 1e-3) leaving = long(n);
+    if (leaving < 0 && zEdge && std::hypot(x - kPressAxisX, y - kPressAxisY) < kPressRadius - 1e-3) leaving = long(n);
     if (entering < 0 && !zEdge && std::fabs(X[0] - 2) < 1e-12) entering = long(n);
   }
   const auto comm = assembly.dofMap()->getComm();
