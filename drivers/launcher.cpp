@@ -1,5 +1,5 @@
-// `capstan`: sets the environment capstan runs in (glibc's heap tunables, an
-// isolated MPI singleton: src/heap_tunables.hpp) and starts capstan-solver,
+// `capstan`: sets the environment capstan runs in (glibc's heap tunables:
+// src/heap_tunables.hpp; Open MPI's start-up: src/mpi_startup.hpp) and starts capstan-solver,
 // the program beside it. Why a launcher: glibc reads its tunables only when a
 // program starts, and the solver program loads about 110 shared libraries
 // (Trilinos, MPI) before main(); starting it once instead of twice saves
@@ -20,7 +20,7 @@ int main(int, char** argv) {
     const std::string path(self, size_t(n));
     solver = path.substr(0, path.rfind('/') + 1) + "capstan-solver";
   }
-  capstan::isolateMpiSingleton();
+  capstan::setMpiStartupDefaults();
   capstan::addHeapTunables();
   execv(solver.c_str(), argv);
   std::perror(("capstan: cannot start " + solver).c_str());

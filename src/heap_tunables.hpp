@@ -27,6 +27,8 @@
 #include <cstring>
 #include <string>
 
+#include "mpi_startup.hpp"
+
 namespace capstan {
 
 inline constexpr const char* kHugePagesTunable = "glibc.malloc.hugetlb";
@@ -55,17 +57,8 @@ inline bool addHeapTunables() {
   return added && setenv("GLIBC_TUNABLES", value.c_str(), 1) == 0;
 }
 
-// A run started without mpiexec is an MPI singleton: by default Open MPI then
-// starts a daemon (orted) for it, 0.12 s of every such run's start-up
-// (docs/performance.md, "Start-up"). An isolated singleton needs none and
-// can do all capstan does. Read by MPI_Init, so it may be set in-process.
-inline void isolateMpiSingleton() {
-  const bool launched = std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMIX_RANK");
-  if (!launched) setenv("OMPI_MCA_ess_singleton_isolated", "1", 0);
-}
-
 inline void reexecWithHeapTunables(char** argv) {
-  isolateMpiSingleton();
+  setMpiStartupDefaults();  // src/mpi_startup.hpp
   if (addHeapTunables()) execv("/proc/self/exe", argv);  // returns only if it failed: run on with glibc's defaults
 }
 

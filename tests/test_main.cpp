@@ -4,7 +4,10 @@
 
 #include <cstdlib>
 
+#include "mpi_startup.hpp"
+
 int main(int argc, char** argv) {
+  capstan::setMpiStartupDefaults();  // as capstan starts (src/mpi_startup.hpp)
   Tpetra::ScopeGuard scope(&argc, &argv);
   ::testing::InitGoogleTest(&argc, argv);
   // Only rank 0 prints results.

@@ -2,7 +2,8 @@
 // (checkpoint, JSON, CSV, progress) agree field for field; the log writes
 // only the topics that are on; the load-step controller with the
 // augmentation loop solves a homogeneous stretch exactly; a failed
-// increment's state comes back as it was. Run on 1 and 2 ranks.
+// increment's state comes back as it was; Open MPI's start-up settings keep
+// the user's. Run on 1 and 2 ranks.
 #include <Tpetra_Core.hpp>
 #include <gtest/gtest.h>
 
@@ -16,6 +17,7 @@
 #include "load_stepper.hpp"
 #include "log.hpp"
 #include "model.hpp"
+#include "mpi_startup.hpp"
 #include "step_figures.hpp"
 #include "step_record.hpp"
 
@@ -188,4 +190,28 @@ TEST(EffectState, RestoreUndoesChangedMultipliers) {
   EXPECT_EQ(multipliers(effects, true), std::vector<double>(anchors.size(), 0.0));
   restoreState(effects, saved);
   EXPECT_EQ(multipliers(effects, true), anchors);
+}
+
+// The start-up defaults (src/mpi_startup.hpp) leave Open MPI's cm layer out
+// unless the user names a layer or a network module; a user's setting wins.
+TEST(MpiStartup, DefaultsKeepTheUsersSettings) {
+  const char* pml = std::getenv("OMPI_MCA_pml");
+  const char* mtl = std::getenv("OMPI_MCA_mtl");
+  const std::string savedPml = pml ? pml : "", savedMtl = mtl ? mtl : "";
+  auto value = [](const char* name) { const char* v = std::getenv(name); return std::string(v ? v : "(unset)"); };
+
+  unsetenv("OMPI_MCA_pml"), unsetenv("OMPI_MCA_mtl");
+  setMpiStartupDefaults();
+  EXPECT_EQ(value("OMPI_MCA_pml"), fastFabricPresent() ? "(unset)" : "^cm");
+
+  setenv("OMPI_MCA_pml", "ob1", 1);
+  setMpiStartupDefaults();
+  EXPECT_EQ(value("OMPI_MCA_pml"), "ob1");
+
+  unsetenv("OMPI_MCA_pml"), setenv("OMPI_MCA_mtl", "psm2", 1);
+  setMpiStartupDefaults();
+  EXPECT_EQ(value("OMPI_MCA_pml"), "(unset)");
+
+  savedPml.empty() ? unsetenv("OMPI_MCA_pml") : setenv("OMPI_MCA_pml", savedPml.c_str(), 1);
+  savedMtl.empty() ? unsetenv("OMPI_MCA_mtl") : setenv("OMPI_MCA_mtl", savedMtl.c_str(), 1);
 }

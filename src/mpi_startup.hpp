@@ -1,0 +1,31 @@
+// Open MPI settings for a fast start, put in the environment before MPI_Init
+// reads them (the launcher, drivers/launcher.cpp, and the programs' main()).
+// A setting already in the environment (the user's, or mpiexec's) is kept.
+//
+// Why (docs/performance.md, "Start-up"):
+// - A run started without mpiexec is an MPI singleton: by default Open MPI
+//   starts a daemon (orted) for it, 0.12 s of every such run. An isolated
+//   singleton needs none and can do all capstan does.
+// - Open MPI's cm messaging layer opens its network modules (MTLs); the
+//   Omni-Path one loads libpsm2, whose constructor sleeps about 0.2 s on a
+//   machine without that hardware. Without cm, Open MPI takes ob1 (shared
+//   memory, TCP, UCX), which it picks there anyway. Left alone where an
+//   Omni-Path or InfiniBand device exists or the user names an MTL.
+#pragma once
+
+#include <unistd.h>
+
+#include <cstdlib>
+
+namespace capstan {
+
+inline bool launchedByMpiexec() { return std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMIX_RANK"); }
+
+inline bool fastFabricPresent() { return access("/dev/hfi1_0", F_OK) == 0 || access("/dev/infiniband", F_OK) == 0; }
+
+inline void setMpiStartupDefaults() {
+  if (!launchedByMpiexec()) setenv("OMPI_MCA_ess_singleton_isolated", "1", 0);
+  if (!fastFabricPresent() && !std::getenv("OMPI_MCA_mtl")) setenv("OMPI_MCA_pml", "^cm", 0);
+}
+
+}  // namespace capstan
