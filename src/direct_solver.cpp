@@ -67,6 +67,10 @@ struct MumpsSolver::Impl {
   // so the same graph object again means the same pattern (only values are
   // read). Held, so that no later graph can take its address.
   RCP<const Tpetra::RowGraph<LO, GO>> graph;
+  // Which of the pattern's entries (in rowPtr's order) MUMPS reads: all, or
+  // with nonzeroPattern those nonzero since the pattern was new, and the
+  // diagonal. a, irn and jcn hold the kept entries only, in the same order.
+  std::vector<char> keep;
 
   // What MUMPS reads: 1-based global row / column numbers and the values.
   // Rows are numbered rank by rank in local order (rank r's rows are
@@ -136,37 +140,32 @@ void MumpsSolver::initialize(const Teuchos::Comm<int>& comm, bool hostOnly) {
 bool MumpsSolver::extractPattern(const CrsMatrix& A) {
   Impl& m = *impl_;
   const LO nRows = static_cast<LO>(A.getNodeNumRows());
-  CrsMatrix::local_inds_host_view_type inds;
-  CrsMatrix::values_host_view_type vals;
   const auto graph = A.getCrsGraph();
+  bool grew = false;
   if (graph.get() == m.graph.get() && std::size_t(nRows) + 1 == m.rowPtr.size()) {
     // Newton's matrix again: its values only (2.6 -> 0.4 ms of each of the 3D
     // drive's factorisations, 1.3 M factor entries, 26 ms). A resumed fill can
     // only add entries, so equal row lengths mean the same pattern.
-    m.a.resize(m.rowPtr.back());
     bool same = true;
-    for (LO r = 0; r < nRows && same; ++r) {
-      A.getLocalRowView(r, inds, vals);
-      same = vals.extent(0) == m.rowPtr[r + 1] - m.rowPtr[r];
-      if (same) std::copy(vals.data(), vals.data() + vals.extent(0), m.a.begin() + m.rowPtr[r]);
+    for (LO r = 0; r < nRows && same; ++r) same = A.getNumEntriesInLocalRow(r) == m.rowPtr[r + 1] - m.rowPtr[r];
+    if (same) {
+      keepNonzeros(A, false, grew);
+      return grew;
     }
-    if (same) return false;
   }
   m.graph = graph;
   const auto& rowMap = *A.getRowMap();
   const auto& colMap = *A.getColMap();
+  CrsMatrix::local_inds_host_view_type inds;
+  CrsMatrix::values_host_view_type vals;
   m.newRowGid.resize(nRows);
   m.newRowPtr.resize(nRows + 1);
   m.newColGid.clear();
-  m.a.clear();
   m.newRowPtr[0] = 0;
   for (LO r = 0; r < nRows; ++r) {
     A.getLocalRowView(r, inds, vals);
     m.newRowGid[r] = rowMap.getGlobalElement(r);
-    for (std::size_t k = 0; k < inds.extent(0); ++k) {
-      m.newColGid.push_back(colMap.getGlobalElement(inds(k)));
-      m.a.push_back(vals(k));
-    }
+    for (std::size_t k = 0; k < inds.extent(0); ++k) m.newColGid.push_back(colMap.getGlobalElement(inds(k)));
     m.newRowPtr[r + 1] = m.newColGid.size();
   }
   const bool changed = m.newRowGid != m.rowGid || m.newRowPtr != m.rowPtr || m.newColGid != m.colGid;
@@ -175,7 +174,34 @@ bool MumpsSolver::extractPattern(const CrsMatrix& A) {
     std::swap(m.newRowPtr, m.rowPtr);
     std::swap(m.newColGid, m.colGid);
   }
-  return changed;
+  keepNonzeros(A, changed, grew);
+  return changed || grew;
+}
+
+// Copies the kept entries' values into a; a nonzero outside the kept ones
+// joins them (grew). fresh: the pattern is new, so is the set kept.
+void MumpsSolver::keepNonzeros(const CrsMatrix& A, bool fresh, bool& grew) {
+  Impl& m = *impl_;
+  const LO nRows = static_cast<LO>(A.getNodeNumRows());
+  if (fresh) {
+    m.keep.assign(m.rowPtr.back(), options_.nonzeroPattern ? 0 : 1);
+    for (LO r = 0; r < nRows; ++r)
+      for (std::size_t k = m.rowPtr[r]; k < m.rowPtr[r + 1]; ++k) m.keep[k] |= m.colGid[k] == m.rowGid[r];
+  }
+  CrsMatrix::local_inds_host_view_type inds;
+  CrsMatrix::values_host_view_type vals;
+  m.a.clear();
+  for (LO r = 0; r < nRows; ++r) {
+    A.getLocalRowView(r, inds, vals);
+    const std::size_t k0 = m.rowPtr[r];
+    for (std::size_t k = 0; k < vals.extent(0); ++k) {
+      if (!m.keep[k0 + k]) {
+        if (vals(k) == 0) continue;
+        m.keep[k0 + k] = 1, grew = true;
+      }
+      m.a.push_back(vals(k));
+    }
+  }
 }
 
 void MumpsSolver::factor(const CrsMatrix& A) {
@@ -230,18 +256,17 @@ void MumpsSolver::analyse(const CrsMatrix& A) {
   std::vector<MUMPS_INT> colIndex(colGids.size());
   for (std::size_t c = 0; c < colIndex.size(); ++c) colIndex[c] = m.offsets[owner[c]] + ownerLid[c] + 1;
 
-  const std::size_t nnz = m.colGid.size();
+  const std::size_t nnz = m.a.size();  // the kept entries
   m.irn.resize(nnz);
   m.jcn.resize(nnz);
   CrsMatrix::local_inds_host_view_type inds;
   CrsMatrix::values_host_view_type vals;
+  std::size_t kept = 0;
   for (int r = 0; r < m.nLocal; ++r) {
     A.getLocalRowView(r, inds, vals);
     const std::size_t k0 = m.rowPtr[r];
-    for (std::size_t k = 0; k < inds.extent(0); ++k) {
-      m.irn[k0 + k] = m.offsets[m.rank] + r + 1;
-      m.jcn[k0 + k] = colIndex[inds(k)];
-    }
+    for (std::size_t k = 0; k < inds.extent(0); ++k)
+      if (m.keep[k0 + k]) m.irn[kept] = m.offsets[m.rank] + r + 1, m.jcn[kept] = colIndex[inds(k)], ++kept;
   }
 
   DMUMPS_STRUC_C& id = m.id;

@@ -68,6 +68,16 @@ struct MumpsOptions {
   // (1 rank: 27.1), the Hertz ring (15,126) 131-143 against 93-99 ms (1 rank:
   // 150). Below 2,000 it goes either way by up to 20%. 0: always all ranks.
   long hostOnlyBelow = 2000;
+  // MUMPS sees only the entries that have been nonzero since the matrix graph
+  // was built (and the diagonal); a zero entry that becomes nonzero joins the
+  // pattern and the analysis is redone. Why: an effect's entity may couple
+  // nodes that only act together where it is active. Steady rolling's
+  // friction couples each contact face to the nodes upstream of it all around
+  // the roller, but only the faces in the nip are active: with every entity in
+  // the pattern the 3D drive's factors hold 1.81 M entries (3.8e8 flops),
+  // with the nonzeros only ... (docs/performance.md, "Linear solvers").
+  // Off: the matrix graph's pattern, zeros and all.
+  bool nonzeroPattern = true;
 };
 
 class MumpsSolver {
@@ -84,8 +94,9 @@ class MumpsSolver {
 
   // Factorises A (fill complete, square, row map = domain map = range map, one
   // to one; any GIDs, contiguous or not). The first call, and any call whose
-  // global sparsity pattern differs from the last one's, runs MUMPS' analysis;
-  // otherwise the analysis is reused and only the numeric factorisation runs.
+  // global sparsity pattern differs from the last one's (with nonzeroPattern:
+  // whose nonzeros are not all in it), runs MUMPS' analysis; otherwise the
+  // analysis is reused and only the numeric factorisation runs.
   // A must live on the communicator of the first call.
   void factor(const CrsMatrix& A);
 
@@ -119,6 +130,7 @@ class MumpsSolver {
   void initialize(const Teuchos::Comm<int>& comm, bool hostOnly);
   void run(int job);  // MUMPS' JOB on the ranks that run it; INFOG on every rank
   bool extractPattern(const CrsMatrix& A);  // true if this rank's pattern changed
+  void keepNonzeros(const CrsMatrix& A, bool fresh, bool& grew);  // the values MUMPS reads, into a
   void analyse(const CrsMatrix& A);
   void computeMetisOrdering();
   double analyseWith(MumpsOptions::Ordering ordering);  // one analysis; returns its estimated flops

@@ -139,6 +139,9 @@ RCP<const Teuchos::ParameterList> validMumpsOptions() {
                "(src/direct_solver.hpp has the measurements)");
     valid->set("Verbose", false, "MUMPS' own printing");
     valid->set("Scaling", false, "Row and column scaling before each factorisation (MUMPS' automatic choice)");
+    valid->set("Nonzero Pattern", true,
+               "MUMPS sees the entries nonzero so far (and the diagonal), the analysis redone when one more turns "
+               "nonzero; false: the matrix graph's whole pattern");
   }
   return valid;
 }
@@ -154,6 +157,7 @@ void readMumpsOptions(Teuchos::ParameterList& list, MumpsShared& shared) {
   if (!known) throw std::invalid_argument("MUMPS: 'Ordering' = '" + ordering + "' is not Metis, Pord, AMD, AMF or QAMD");
   shared.options.verbose = list.get<bool>("Verbose");
   shared.options.scaling = list.get<bool>("Scaling");
+  shared.options.nonzeroPattern = list.get<bool>("Nonzero Pattern");
   shared.solver.reset();
   shared.factoredFor = nullptr;
 }

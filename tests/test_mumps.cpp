@@ -1,7 +1,8 @@
 // MumpsSolver (src/direct_solver.hpp): solves of a non-symmetric 3D
 // convection-diffusion operator with several right-hand sides, against a known
 // solution; refactorisation reusing the analysis; a new analysis for a changed
-// pattern; non-contiguous maps; the same answer as a one-rank solve of the same
+// pattern; entries zero so far kept out of the pattern until they turn
+// nonzero (MumpsOptions::nonzeroPattern); non-contiguous maps; the same answer as a one-rank solve of the same
 // system; singular matrices throw (and the solver recovers). Run on 1 and 2
 // ranks (test_mumps_2ranks). MumpsTiming prints the analysis and factorisation
 // times of 3-dof elasticity-like stencils (the 52,728-unknown one is disabled:
@@ -59,6 +60,7 @@ struct ConvDiff {
   double velocity = 1.0;   // scales the upwinded convection (1, 0.5, 0.25)
   double shift = 0.0;      // added to the diagonal
   bool farCouplings = false;  // couple g and N-1-g (a different pattern)
+  double far = 1.0;           // scales those couplings (0: in the pattern, zero)
 };
 
 // 7-point diffusion plus first-order upwind convection on the 6x5x4 grid,
@@ -80,7 +82,7 @@ RCP<CrsMatrix> convectionDiffusion(RCP<const Map> map, const ConvDiff& c) {
     add(j < NY - 1, g + NX, -1.0);
     add(k > 0, g - NX * NY, -1.0 - v[2]);
     add(k < NZ - 1, g + NX * NY, -1.0);
-    if (c.farCouplings) add(true, N - 1 - g, g < N / 2 ? 0.7 : -0.4);
+    if (c.farCouplings) add(true, N - 1 - g, c.far * (g < N / 2 ? 0.7 : -0.4));
     A->insertGlobalValues(g, Teuchos::arrayViewFromVector(cols), Teuchos::arrayViewFromVector(vals));
   }
   A->fillComplete();
@@ -274,6 +276,43 @@ TEST(Mumps, ChangedPatternGetsANewAnalysis) {
   EXPECT_EQ(solver.numAnalyses(), 3);
   EXPECT_EQ(solver.numFactorizations(), 3);
   solveAndCheck(solver, *A1, 2);
+}
+
+// Zero entries of the graph stay out of MUMPS' pattern (fewer factor
+// entries), join it when they turn nonzero (one more analysis) and stay in it
+// when they are zero again (no analysis).
+TEST(Mumps, ZeroEntriesJoinThePatternWhenTheyTurnNonzero) {
+  auto map = contiguousMap(N, worldComm());
+  auto A = convectionDiffusion(map, ConvDiff{1.0, 0.5, true, 0.0});
+  MumpsOptions all = testOptions();
+  all.nonzeroPattern = false;
+  MumpsSolver whole(all), nonzeros(testOptions());
+  whole.factor(*A);
+  nonzeros.factor(*A);
+  EXPECT_LT(nonzeros.factorEntries(), whole.factorEntries() * 3 / 4);
+  solveAndCheck(nonzeros, *A, 2);
+  auto setFar = [&](double far) {
+    A->resumeFill();
+    for (LO l = 0; l < LO(map->getNodeNumElements()); ++l) {
+      const GO g = map->getGlobalElement(l);
+      const GO col = N - 1 - g;
+      const double v = far * (g < N / 2 ? 0.7 : -0.4);
+      A->replaceGlobalValues(g, Teuchos::tuple<GO>(col), Teuchos::tuple<double>(v));
+    }
+    A->fillComplete();
+  };
+  setFar(1.0);
+  nonzeros.factor(*A);
+  whole.factor(*A);
+  EXPECT_EQ(nonzeros.numAnalyses(), 2);
+  EXPECT_EQ(whole.numAnalyses(), 1);
+  EXPECT_EQ(nonzeros.factorEntries(), whole.factorEntries());
+  solveAndCheck(nonzeros, *A, 2);
+  setFar(0.0);
+  nonzeros.factor(*A);
+  EXPECT_EQ(nonzeros.numAnalyses(), 2);
+  EXPECT_EQ(nonzeros.numFactorizations(), 3);
+  solveAndCheck(nonzeros, *A, 2);
 }
 
 TEST(Mumps, NonContiguousMapAndOneRankAgree) {
