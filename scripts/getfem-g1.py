@@ -256,7 +256,12 @@ def run_getfem_process(refine, args):
 
 
 def compare(args, refines):
-    tmp = tempfile.mkdtemp(prefix="g1cmp-", dir=HERE)
+    # capstan's outputs go to a scratch folder, removed afterwards (never the source tree).
+    with tempfile.TemporaryDirectory(prefix="g1cmp-") as tmp:
+        compare_in(args, refines, tmp)
+
+
+def compare_in(args, refines, tmp):
     print("capstan: %s; GetFEM: %s; Newton rtol %g; BLAS dir for both: %s; "
           "OMP_NUM_THREADS=%s" % (args.compare, sys.executable, args.rtol,
                                   args.blas_dir or "system default",

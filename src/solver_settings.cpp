@@ -13,8 +13,8 @@ const std::vector<std::pair<const char*, S::LineSearch>> S::lineSearches = {
 void SolverSettings::declare(ParameterList& sol) {
   sol.set("Linear Solver", std::string("Auto"),
           "Auto | GMRES | CG | Direct (Belos GMRES, Belos CG, MUMPS on any number of ranks). Auto, up to "
-          "Direct Solver Max Dofs: Direct with friction, GMRES with an LU preconditioner without; "
-          "above it GMRES (docs/performance.md, \"Linear solvers\")");
+          "Direct Solver Max Dofs: Direct with friction or in steady rolling, GMRES with an LU preconditioner "
+          "otherwise; above it GMRES (with LU in steady rolling; docs/performance.md, \"Linear solvers\")");
   sol.set("Direct Solver Max Dofs", 0,
           "Auto: the largest problem factorised by MUMPS; 0: automatic, 5,000 on a Box mesh, 50,000 "
           "on an Annulus (graded rings, on which smoothed aggregation needs hundreds of iterations)");
@@ -151,15 +151,17 @@ SolverSettings SolverSettings::resolved(long dofs, bool annulus, bool friction, 
   SolverSettings s = *this;
   s.gradedRings = gradedRings || annulus;  // NewtonSolver resolves again, knowing no mesh
   if (s.linearSolver == LinearSolver::Auto && steady) {
-    // Steady rolling: most Newton iterations are augmentation passes near the
-    // answer, where a factorisation kept across iterations wins (the 3D drive
-    // 7.4-8.2 s against 8.0-8.6 s factorising each time, the slice's brake
-    // sweep 2.1 against 2.8 s, the Carter coating 37 against 51 s; same
-    // iterations and answers: docs/steady-rolling.md). At
-    // any size: omega's row (the torque balance) has no diagonal, which
-    // smoothers cannot take.
-    s.linearSolver = LinearSolver::GMRES;
-    if (s.preconditioner == Preconditioner::Auto) s.preconditioner = Preconditioner::LU;
+    // Steady rolling: a factorisation every Newton iteration up to the direct
+    // solver's size, as with friction elsewhere (the 3D drive 1.55-1.68 s
+    // against 1.93-1.97 s with a kept one, the slice's brake sweep 0.55 against
+    // 0.62-0.64 s, the Carter coating 8.2 against 10.2 s; the same answers:
+    // docs/steady-rolling.md); above it GMRES with a kept factorisation. Never
+    // MueLu: omega's row (the torque balance) has no diagonal, which smoothers
+    // cannot take.
+    const long most = s.directSolverMaxDofs > 0 ? s.directSolverMaxDofs : annulus ? 50000 : 5000;
+    s.linearSolver = dofs > most ? LinearSolver::GMRES : LinearSolver::Direct;
+    if (s.linearSolver == LinearSolver::GMRES && s.preconditioner == Preconditioner::Auto)
+      s.preconditioner = Preconditioner::LU;
   }
   if (s.linearSolver == LinearSolver::Auto) {
     const long most = s.directSolverMaxDofs > 0 ? s.directSolverMaxDofs : annulus ? 50000 : 5000;

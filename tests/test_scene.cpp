@@ -668,6 +668,7 @@ TEST_F(SceneTest, UnreachableCapstanWarning) {
 // "Linear solvers"): MUMPS up to 5,000 dofs on a box, 50,000 on an annulus;
 // factorised every Newton iteration with friction, kept as GMRES's LU
 // preconditioner without; GMRES with MueLu (ILU below 1000 dofs) above.
+// Steady rolling: MUMPS likewise up to that size, GMRES + LU above.
 TEST(SolverSettings, AutoResolvesByKindAndSize) {
   using S = SolverSettings;
   const S s = S::defaults();
@@ -683,11 +684,11 @@ TEST(SolverSettings, AutoResolvesByKindAndSize) {
   EXPECT_EQ(pick(s, 15120, true, false), std::make_pair(S::LinearSolver::GMRES, S::Preconditioner::LU));
   EXPECT_EQ(pick(s, 50001, true, false), std::make_pair(S::LinearSolver::GMRES, S::Preconditioner::MueLu));
   EXPECT_EQ(pick(s, 500, true, false).second, S::Preconditioner::LU);
-  // Steady rolling: a kept factorisation at any size (omega's row has no diagonal).
-  for (long dofs : {1920L, 200000L}) {
-    const S r = s.resolved(dofs, true, true, true);
-    EXPECT_EQ(std::make_pair(r.linearSolver, r.preconditioner), std::make_pair(S::LinearSolver::GMRES, S::Preconditioner::LU));
-  }
+  // Steady rolling: a factorisation every iteration up to the direct size, a
+  // kept one above it, never MueLu (omega's row has no diagonal).
+  for (long dofs : {1920L, 50000L}) EXPECT_EQ(s.resolved(dofs, true, true, true).linearSolver, S::LinearSolver::Direct);
+  const S big = s.resolved(50001, true, true, true);
+  EXPECT_EQ(std::make_pair(big.linearSolver, big.preconditioner), std::make_pair(S::LinearSolver::GMRES, S::Preconditioner::LU));
   EXPECT_TRUE(s.resolved(60000, true, false).gradedRings) << "an annulus' MueLu smooths for graded rings";
   EXPECT_FALSE(s.resolved(60000, false, false).gradedRings);
   EXPECT_TRUE(s.resolved(60000, true, false).resolved(60000, false, false).gradedRings) << "kept when resolved again";
