@@ -314,7 +314,8 @@ double MumpsSolver::analyseWith(MumpsOptions::Ordering ordering) {
   DMUMPS_STRUC_C& id = m.id;
   id.perm_in = nullptr;
   switch (ordering) {
-    case MumpsOptions::Ordering::Auto:  // analyse() resolves it
+    case MumpsOptions::Ordering::Auto:  // analyse() resolves Auto before it gets here
+      throw std::logic_error("MumpsSolver::analyseWith: Auto is not an ordering of its own");
     case MumpsOptions::Ordering::Metis:
       computeMetisOrdering();  // collective
       ICNTL(id, 7) = 1;

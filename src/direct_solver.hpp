@@ -67,6 +67,7 @@ struct MumpsOptions {
   // against 9.4-9.6 ms, the 3D drive (4,806) 26.1-27.3 against 17.3-19.1 ms
   // (1 rank: 27.1), the Hertz ring (15,126) 131-143 against 93-99 ms (1 rank:
   // 150). Below 2,000 it goes either way by up to 20%. 0: always all ranks.
+  // Scene: Solver/Stratimikos/Linear Solver Types/MUMPS/Host Only Below.
   long hostOnlyBelow = 2000;
   // MUMPS sees only the entries that have been nonzero since the matrix graph
   // was built (and the diagonal); a zero entry that becomes nonzero joins the

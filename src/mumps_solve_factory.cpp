@@ -139,6 +139,9 @@ RCP<const Teuchos::ParameterList> validMumpsOptions() {
                "(src/direct_solver.hpp has the measurements)");
     valid->set("Verbose", false, "MUMPS' own printing");
     valid->set("Scaling", false, "Row and column scaling before each factorisation (MUMPS' automatic choice)");
+    valid->set("Host Only Below", 2000,
+               "Matrices with fewer rows are factored on rank 0 alone, larger ones by every rank; 0: always every "
+               "rank (src/direct_solver.hpp has the measurements)");
     valid->set("Nonzero Pattern", true,
                "MUMPS sees the entries nonzero so far (and the diagonal), the analysis redone when one more turns "
                "nonzero; false: the matrix graph's whole pattern");
@@ -158,6 +161,9 @@ void readMumpsOptions(Teuchos::ParameterList& list, MumpsShared& shared) {
   shared.options.verbose = list.get<bool>("Verbose");
   shared.options.scaling = list.get<bool>("Scaling");
   shared.options.nonzeroPattern = list.get<bool>("Nonzero Pattern");
+  const int hostOnlyBelow = list.get<int>("Host Only Below");
+  if (hostOnlyBelow < 0) throw std::invalid_argument("MUMPS: 'Host Only Below' = " + std::to_string(hostOnlyBelow) + " is negative");
+  shared.options.hostOnlyBelow = hostOnlyBelow;
   shared.solver.reset();
   shared.factoredFor = nullptr;
 }

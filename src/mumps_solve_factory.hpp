@@ -24,7 +24,7 @@ struct MumpsShared {
 };
 
 // The parameters both factories take: "Ordering" (Metis | Pord | AMD | AMF |
-// QAMD), "Verbose", "Scaling", "Nonzero Pattern" (MumpsOptions).
+// QAMD), "Verbose", "Scaling", "Host Only Below", "Nonzero Pattern" (MumpsOptions).
 Teuchos::RCP<const Teuchos::ParameterList> validMumpsOptions();
 void readMumpsOptions(Teuchos::ParameterList& list, MumpsShared& shared);
 

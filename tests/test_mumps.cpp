@@ -190,6 +190,9 @@ TEST(MumpsThyra, OperatorsShareTheAnalysisAndSolveWithTheirOwnValues) {
   auto bad = Teuchos::parameterList();
   bad->set("Ordering", "Nested");
   EXPECT_THROW(factory->setParameterList(bad), std::invalid_argument);
+  auto negative = Teuchos::parameterList();  // so is a negative size
+  negative->set("Host Only Below", -1);
+  EXPECT_THROW(factory->setParameterList(negative), std::invalid_argument);
 }
 
 TEST(Mumps, EveryOrderingSolves) {
