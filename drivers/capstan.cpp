@@ -12,6 +12,7 @@
 #include "errors.hpp"
 #include "heap_tunables.hpp"
 #include "log.hpp"
+#include "mumps_parameters.hpp"
 #include "scene.hpp"
 #include "simulation.hpp"
 
@@ -100,8 +101,13 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (args.command == "params") {
-    if (rank0)
-      capstan::validParameters().print(std::cout, Teuchos::ParameterList::PrintOptions().showDoc(true).showTypes(true).indent(2));
+    if (rank0) {
+      const auto options = Teuchos::ParameterList::PrintOptions().showDoc(true).showTypes(true).indent(2);
+      capstan::validParameters().print(std::cout, options);
+      // Stratimikos' list is passed through; the MUMPS part of it is capstan's own.
+      std::cout << "\nSolver/Stratimikos/Linear Solver Types/MUMPS (Linear Solver = Direct, Preconditioner = LU):\n";
+      capstan::validMumpsOptions()->print(std::cout, options);
+    }
     return 0;
   }
   if (args.command == "--help" || args.command == "help") {

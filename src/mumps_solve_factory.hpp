@@ -12,6 +12,7 @@
 #include <memory>
 
 #include "direct_solver.hpp"
+#include "mumps_parameters.hpp"
 
 namespace capstan {
 
@@ -23,9 +24,7 @@ struct MumpsShared {
   const void* factoredFor = nullptr;    // the operator whose values are factored
 };
 
-// The parameters both factories take: "Ordering" (Metis | Pord | AMD | AMF |
-// QAMD), "Verbose", "Scaling", "Host Only Below", "Nonzero Pattern" (MumpsOptions).
-Teuchos::RCP<const Teuchos::ParameterList> validMumpsOptions();
+// The parameters both factories take: validMumpsOptions (mumps_parameters.hpp).
 void readMumpsOptions(Teuchos::ParameterList& list, MumpsShared& shared);
 
 template <class Base>

@@ -112,6 +112,8 @@ T.check(p.returncode == 0 and p.stdout.strip() != "",
 p = T.capstan_run(["params"], cwd=work)
 T.check(p.returncode == 0, f"capstan params: exit {p.returncode}")
 T.check("Pressure Penalty" in p.stdout, f"capstan params prints 'Pressure Penalty' ({len(p.stdout)} characters)")
+T.check("Nonzero Pattern" in p.stdout and "Host Only Below" in p.stdout,
+        "capstan params prints the MUMPS settings ('Nonzero Pattern', 'Host Only Below')")
 before = listing(work)
 p = T.capstan_run(["validate", T.input("uniaxial.xml")], cwd=work)
 T.check(p.returncode == 0, f"capstan validate inputs/uniaxial.xml: exit {p.returncode} {p.stderr.strip()[:200]}")
