@@ -141,17 +141,13 @@ bool MumpsSolver::extractPattern(const CrsMatrix& A) {
   Impl& m = *impl_;
   const LO nRows = static_cast<LO>(A.getNodeNumRows());
   const auto graph = A.getCrsGraph();
-  bool grew = false;
   if (graph.get() == m.graph.get() && std::size_t(nRows) + 1 == m.rowPtr.size()) {
     // Newton's matrix again: its values only (2.6 -> 0.4 ms of each of the 3D
     // drive's factorisations, 1.3 M factor entries, 26 ms). A resumed fill can
     // only add entries, so equal row lengths mean the same pattern.
     bool same = true;
     for (LO r = 0; r < nRows && same; ++r) same = A.getNumEntriesInLocalRow(r) == m.rowPtr[r + 1] - m.rowPtr[r];
-    if (same) {
-      keepNonzeros(A, false, grew);
-      return grew;
-    }
+    if (same) return keepNonzeros(A, false);
   }
   m.graph = graph;
   const auto& rowMap = *A.getRowMap();
@@ -174,14 +170,15 @@ bool MumpsSolver::extractPattern(const CrsMatrix& A) {
     std::swap(m.newRowPtr, m.rowPtr);
     std::swap(m.newColGid, m.colGid);
   }
-  keepNonzeros(A, changed, grew);
+  const bool grew = keepNonzeros(A, changed);
   return changed || grew;
 }
 
 // Copies the kept entries' values into a; a nonzero outside the kept ones
-// joins them (grew). fresh: the pattern is new, so is the set kept.
-void MumpsSolver::keepNonzeros(const CrsMatrix& A, bool fresh, bool& grew) {
+// joins them (returns true). fresh: the pattern is new, so is the set kept.
+bool MumpsSolver::keepNonzeros(const CrsMatrix& A, bool fresh) {
   Impl& m = *impl_;
+  bool grew = false;
   const LO nRows = static_cast<LO>(A.getNodeNumRows());
   if (fresh) {
     m.keep.assign(m.rowPtr.back(), options_.nonzeroPattern ? 0 : 1);
@@ -202,6 +199,7 @@ void MumpsSolver::keepNonzeros(const CrsMatrix& A, bool fresh, bool& grew) {
       m.a.push_back(vals(k));
     }
   }
+  return grew;
 }
 
 void MumpsSolver::factor(const CrsMatrix& A) {

@@ -135,7 +135,7 @@ class MumpsSolver {
   void initialize(const Teuchos::Comm<int>& comm, bool hostOnly);
   void run(int job);  // MUMPS' JOB on the ranks that run it; INFOG on every rank
   bool extractPattern(const CrsMatrix& A);  // true if this rank's pattern changed
-  void keepNonzeros(const CrsMatrix& A, bool fresh, bool& grew);  // the values MUMPS reads, into a
+  bool keepNonzeros(const CrsMatrix& A, bool fresh);  // the values MUMPS reads; true if the kept set grew
   void analyse(const CrsMatrix& A);
   void computeMetisOrdering();
   double analyseWith(MumpsOptions::Ordering ordering);  // one analysis; returns its estimated flops
