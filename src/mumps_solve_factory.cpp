@@ -157,7 +157,7 @@ void readMumpsOptions(Teuchos::ParameterList& list, MumpsShared& shared) {
   bool known = false;
   for (const auto& [name, value] : kOrderings)
     if (ordering == name) shared.options.ordering = value, known = true;
-  if (!known) throw std::invalid_argument("MUMPS: 'Ordering' = '" + ordering + "' is not Metis, Pord, AMD, AMF or QAMD");
+  if (!known) throw std::invalid_argument("MUMPS: 'Ordering' = '" + ordering + "' is not Auto, Metis, Pord, AMD, AMF or QAMD");
   shared.options.verbose = list.get<bool>("Verbose");
   shared.options.scaling = list.get<bool>("Scaling");
   shared.options.nonzeroPattern = list.get<bool>("Nonzero Pattern");

@@ -150,6 +150,7 @@ SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterRe
 SolverSettings SolverSettings::resolved(long dofs, bool annulus, bool friction, bool steady) const {
   SolverSettings s = *this;
   s.gradedRings = gradedRings || annulus;  // NewtonSolver resolves again, knowing no mesh
+  const long most = s.directSolverMaxDofs > 0 ? s.directSolverMaxDofs : annulus ? 50000 : 5000;  // Auto's direct size
   if (s.linearSolver == LinearSolver::Auto && steady) {
     // Steady rolling: a factorisation every Newton iteration up to the direct
     // solver's size, as with friction elsewhere (the 3D drive 1.55-1.68 s
@@ -158,13 +159,11 @@ SolverSettings SolverSettings::resolved(long dofs, bool annulus, bool friction, 
     // docs/steady-rolling.md); above it GMRES with a kept factorisation. Never
     // MueLu: omega's row (the torque balance) has no diagonal, which smoothers
     // cannot take.
-    const long most = s.directSolverMaxDofs > 0 ? s.directSolverMaxDofs : annulus ? 50000 : 5000;
     s.linearSolver = dofs > most ? LinearSolver::GMRES : LinearSolver::Direct;
     if (s.linearSolver == LinearSolver::GMRES && s.preconditioner == Preconditioner::Auto)
       s.preconditioner = Preconditioner::LU;
   }
   if (s.linearSolver == LinearSolver::Auto) {
-    const long most = s.directSolverMaxDofs > 0 ? s.directSolverMaxDofs : annulus ? 50000 : 5000;
     if (dofs > most) {
       s.linearSolver = LinearSolver::GMRES;
     } else if (friction) {
