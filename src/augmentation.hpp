@@ -32,7 +32,8 @@ class AugmentationLoop {
   // moves u and the multipliers together. False if the block solve made no
   // progress (nothing is changed then).
   // volumeMet: the volumes already meet their tolerance (a step for other rows).
-  bool saddlePointPressureStep(double t, Vector& f, bool volumeMet, StepRecord& rec);
+  // monolithic: no Newton solve follows (Pressure Update = Monolithic).
+  bool saddlePointPressureStep(double t, Vector& f, bool volumeMet, bool monolithic, StepRecord& rec);
   // One full Newton step from u, whose residual `start` is within the
   // absolute tolerance, kept if it lowers the residual: one iteration.
   NewtonResult polish(double t, double start);

@@ -48,6 +48,7 @@ Model::Model(const Scene& scene_, const RCP<const Comm>& comm_)
     const bool laplacian = schur == S::Schur::Laplacian || (schur == S::Schur::Auto && newton->iterative());
     pressureStep = std::make_unique<PressureStep>(
         *assembly, laplacian ? PressureStep::Schur::Laplacian : PressureStep::Schur::Diagonal);
+    monolithic = scene.solver.monolithic && !(scene.solver.monolithicIfExact && newton->iterative());
   }
   u = rcp(new Vector(assembly->dofMap()));
   for (const auto& core : assembly->rigidCores()) rolling = rolling || core.free[3];

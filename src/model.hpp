@@ -28,6 +28,9 @@ struct Model {
   std::unique_ptr<Assembly> assembly;
   std::unique_ptr<NewtonSolver> newton;
   std::unique_ptr<PressureStep> pressureStep;  // null with Solver/Pressure Update = Anderson
+  // The pressure loop's passes are saddle-point steps alone (Pressure Update =
+  // Monolithic, or Auto without friction where the step's K^-1 is exact).
+  bool monolithic = false;
   RCP<Vector> u;
   // A rigid core turns freely: the rolling measures (extrapolation, rolling
   // first guess, settled multipliers) are on.

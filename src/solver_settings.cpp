@@ -59,9 +59,13 @@ void SolverSettings::declare(ParameterList& sol) {
           "How the pressure loop moves the element pressure anchors after each Newton solve: "
           "Saddle Point (positions, anchors, exact contact's multipliers and Coulomb's stick tractions from one block Krylov solve, "
           "v_e = V_e and g = 0 to first order), "
-          "Anderson (pbar <- p(x), Anderson-accelerated), or Auto (Saddle Point without friction, for a "
+          "Monolithic (the same step taken from the predictor on and repeated, with no Newton solve on the positions "
+          "alone in between: Newton's method on positions, anchors and multipliers together; no friction), "
+          "Anderson (pbar <- p(x), Anderson-accelerated), or Auto (Monolithic without friction where the step's K^-1 is exact, with a direct solver or the LU "
+          "preconditioner, Saddle Point elsewhere without friction, for a "
           "free-turning core rolling with friction in the quasi-static analysis and for steady rolling; "
-          "Anderson for other friction scenes; docs/friction.md, \"The multiplier loop in rolling\")");
+          "Anderson for other friction scenes; docs/friction.md, \"The multiplier loop in rolling\", "
+          "docs/performance.md, \"Defaults and why\")");
   sol.set("Pressure Step Schur", std::string("Auto"),
           "The saddle-point step's approximation of its volume rows' Schur complement: Laplacian "
           "((eps V)^-1 + 0.15 L^-1, L = G^T diag(K0)^-1 G by 30 CG iterations: it holds Q1P0's nearly "
@@ -121,12 +125,22 @@ SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterRe
   // iterations against 168). Other friction scenes keep Anderson: with the step
   // H4 at k = 0.01 takes another stick/slip path, 1.3e-4 from its finely
   // stepped reference (docs/friction.md, "The multiplier loop in rolling").
-  enum class Update { Auto, SaddlePoint, Anderson };
+  // Without friction the step is Newton's own (Monolithic): G1 1x 0 Newton
+  // iterations and 20 steps against 33 and 15, 0.20 s against 0.38 s
+  // (docs/performance.md, "Defaults and why"). With friction it is not: each
+  // step moves points between stick, slip and free, and the steady drive's
+  // friction stage diverged with it.
+  enum class Update { Auto, SaddlePoint, Monolithic, Anderson };
   const Update update = r.choice(sol, at, "Pressure Update",
                                  std::vector<std::pair<const char*, Update>>{{"Auto", Update::Auto},
                                                                              {"Saddle Point", Update::SaddlePoint},
+                                                                             {"Monolithic", Update::Monolithic},
                                                                              {"Anderson", Update::Anderson}});
-  s.pressureUpdate = update == Update::SaddlePoint || (update == Update::Auto && (!friction || rolling || steady))
+  if (update == Update::Monolithic && friction)
+    r.fail("Solver/Pressure Update", "Monolithic takes no friction (a capstan has Friction); use Saddle Point or Auto");
+  s.monolithic = update == Update::Monolithic || (update == Update::Auto && !friction);
+  s.monolithicIfExact = update == Update::Auto;
+  s.pressureUpdate = update == Update::SaddlePoint || s.monolithic || (update == Update::Auto && (rolling || steady))
                          ? PressureUpdate::SaddlePoint
                          : PressureUpdate::Anderson;
   s.pressureStepSchur = r.choice(sol, at, "Pressure Step Schur",

@@ -41,6 +41,13 @@ struct SolverSettings {
   double volumeTolerance = 0;
   int maxPressureIterations = 0;
   PressureUpdate pressureUpdate{};
+  // Pressure Update = Monolithic (Auto without friction): each pass of the
+  // pressure loop is one saddle-point step from where the last left off, with
+  // no Newton solve on the positions alone in between (src/augmentation.cpp).
+  // Auto's only where the step's K^-1 is exact (a direct solver or the LU
+  // preconditioner; Model decides, knowing the linear solver).
+  bool monolithic = false;
+  bool monolithicIfExact = false;
   Schur pressureStepSchur{};
   int pressureAccelerationDepth = 0;
   double minimumSolvePenalty = 0;  // resolved: > 0
@@ -52,8 +59,8 @@ struct SolverSettings {
   static void declare(Teuchos::ParameterList& solver);
   // `friction`: some capstan has friction; `rolling`: a free-turning rigid
   // core in the quasi-static analysis; `steady`: the steady-rolling analysis
-  // (Pressure Update = Auto picks Anderson with friction unless rolling or
-  // steady).
+  // (Pressure Update = Auto picks Monolithic without friction, Anderson with
+  // friction unless rolling or steady).
   static SolverSettings parse(const Teuchos::ParameterList& solver, const ParameterReader& r, bool friction,
                               bool rolling = false, bool steady = false);
   // Linear Solver = Auto and Preconditioner = Auto resolved for a problem of

@@ -706,13 +706,34 @@ TEST(SolverSettings, AutoResolvesByKindAndSize) {
 }
 
 // Pressure Update = Auto by the scene's kind (docs/friction.md, "The multiplier
-// loop in rolling"): the saddle-point step but for non-rolling friction scenes.
+// loop in rolling"): the saddle-point step but for non-rolling friction scenes,
+// and without friction as the monolithic Newton step.
 TEST(SolverSettings, PressureUpdateAutoByKind) {
   using P = SolverSettings::PressureUpdate;
   EXPECT_EQ(SolverSettings::defaults(false).pressureUpdate, P::SaddlePoint) << "no friction";
+  EXPECT_TRUE(SolverSettings::defaults(false).monolithic) << "no friction";
+  EXPECT_TRUE(SolverSettings::defaults(false, false, true).monolithic) << "steady, no friction";
+  EXPECT_FALSE(SolverSettings::defaults(true, true).monolithic) << "quasi-static rolling";
+  EXPECT_FALSE(SolverSettings::defaults(true, false, true).monolithic) << "steady rolling";
   EXPECT_EQ(SolverSettings::defaults(true).pressureUpdate, P::Anderson) << "friction, no rolling (H1-H5)";
   EXPECT_EQ(SolverSettings::defaults(true, true).pressureUpdate, P::SaddlePoint) << "quasi-static rolling";
   EXPECT_EQ(SolverSettings::defaults(true, false, true).pressureUpdate, P::SaddlePoint) << "steady rolling";
+}
+
+// Monolithic steps take no friction (stick, slip and free change under each
+// step): asked for with friction, the scene is rejected at its parameter.
+TEST(SolverSettings, MonolithicWithFrictionIsBadInput) {
+  Teuchos::ParameterList list;
+  SolverSettings::declare(list);
+  list.set("Pressure Update", std::string("Monolithic"));
+  EXPECT_TRUE(SolverSettings::parse(list, ParameterReader{"scene.xml"}, false).monolithic);
+  try {
+    SolverSettings::parse(list, ParameterReader{"scene.xml"}, true);
+    ADD_FAILURE() << "no InputError for Monolithic with friction";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("Solver/Pressure Update"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("scene.xml"), std::string::npos) << e.what();
+  }
 }
 
 // Max Newton Iterations = 0: 60 for rolling with friction, quasi-static or

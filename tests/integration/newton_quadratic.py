@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Newton converges quadratically (the tangent is consistent with the residual).
 
-Runs inputs/shear.xml with --log newton, which writes one event per Newton solve
+Runs inputs/shear.xml (with the nested pressure loop, Pressure Update = Saddle
+Point, whose passes are Newton solves) with --log newton, which writes one event per Newton solve
 to OUTDIR/log.jsonl:  {"event": "newton", "step": k, "residuals": [r0, r1, ...], ...}
 as given (Auto linear solver: direct on one rank, tangent predictor), with
 Solver/Predictor=Previous (Newton starts farther from the solution: longer
@@ -59,8 +60,12 @@ def parse(outdir):
 
 
 total_pairs = 0
-for label, sets in (("as given", []), ("Predictor=Previous", ["Solver/Predictor=Previous"]),
-                    ("GMRES", ["Solver/Linear Solver=GMRES", "Solver/Linear Tolerance Method=Fixed"])):
+# The nested pressure loop (Saddle Point): a Newton solve on the positions in
+# every pass. Auto's Monolithic takes saddle-point steps only, with no Newton
+# solve to look at (pressure_update.py checks where it lands).
+NESTED = ["Solver/Pressure Update=Saddle Point"]
+for label, sets in (("as given", NESTED), ("Predictor=Previous", NESTED + ["Solver/Predictor=Previous"]),
+                    ("GMRES", NESTED + ["Solver/Linear Solver=GMRES", "Solver/Linear Tolerance Method=Fixed"])):
     print(f"\n  --- shear.xml, {label}")
     p, s, out = T.run_scene(scene, f"shear-{len(sets)}-{label.split('=')[0].replace(' ', '')}", sets=sets,
                             extra=["--log", "newton"])
