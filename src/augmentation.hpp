@@ -51,6 +51,7 @@ class AugmentationLoop {
   // through wider laws (src/regularisation_continuation.hpp).
   RegularisationContinuation continuation_;
   std::vector<Kokkos::View<double*>> pressureStepDmu_;  // per effect: its multipliers' change in the step
+  bool lastStepShortened_ = false;                     // the last saddle-point step was halved
 };
 
 }  // namespace capstan

@@ -146,6 +146,11 @@ class MumpsSolver {
   std::unique_ptr<Impl> impl_;
   bool analysed_ = false, factored_ = false;
   int numAnalyses_ = 0, numFactorizations_ = 0, numWorkspaceRetries_ = 0;
+  // Ordering = Auto: the winner of the last contest and the entries it was
+  // decided on, kept for later analyses while the pattern has grown by less
+  // than a tenth (contact or friction entries joining).
+  MumpsOptions::Ordering autoWinner_ = MumpsOptions::Ordering::Auto;
+  double autoWinnerEntries_ = 0;
   double analysisSeconds_ = 0, factorSeconds_ = 0, solveSeconds_ = 0;
 };
 
