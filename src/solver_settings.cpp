@@ -125,11 +125,13 @@ SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterRe
   // iterations against 168). Other friction scenes keep Anderson: with the step
   // H4 at k = 0.01 takes another stick/slip path, 1.3e-4 from its finely
   // stepped reference (docs/friction.md, "The multiplier loop in rolling").
-  // Without friction the step is Newton's own (Monolithic): G1 1x 0 Newton
-  // iterations and 20 steps against 33 and 15, 0.20 s against 0.38 s
-  // (docs/performance.md, "Defaults and why"). With friction it is not: each
-  // step moves points between stick, slip and free, and the steady drive's
-  // friction stage diverged with it.
+  // Without friction the step is Newton's own (Monolithic): G1 1x 19 steps
+  // against 33 Newton iterations and 15 steps, 0.27 s against 0.37 s; the
+  // Hertz ring 1.45 s against 1.86 s. Only with exact linear solves: with
+  // MueLu each step's GMRES gets one V-cycle per K^-1, and G1 2x took 5.71 s
+  // against 4.82 s (docs/performance.md, "Defaults and why"). With friction
+  // each step moves points between stick, slip and free, and the steady
+  // drive's first friction solve diverged.
   enum class Update { Auto, SaddlePoint, Monolithic, Anderson };
   const Update update = r.choice(sol, at, "Pressure Update",
                                  std::vector<std::pair<const char*, Update>>{{"Auto", Update::Auto},
