@@ -128,8 +128,9 @@ SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterRe
   // Without friction the step is Newton's own (Monolithic): G1 1x 19 steps
   // against 33 Newton iterations and 15 steps, 0.27 s against 0.37 s; the
   // Hertz ring 1.45 s against 1.86 s. Only with exact linear solves: with
-  // MueLu each step's GMRES gets one V-cycle per K^-1, and G1 2x took 5.71 s
-  // against 4.82 s (docs/performance.md, "Defaults and why"). With friction
+  // MueLu each step's GMRES gets one V-cycle per K^-1, and the gain fades
+  // (G1 2x 4.34 s against 5.02 s, 4x 51.1 against 49.6 s with 13% more
+  // memory; docs/performance.md, "Defaults and why"). With friction
   // each step moves points between stick, slip and free, and the steady
   // drive's first friction solve diverged.
   enum class Update { Auto, SaddlePoint, Monolithic, Anderson };
