@@ -167,7 +167,15 @@ SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterRe
 SolverSettings SolverSettings::resolved(long dofs, bool annulus, bool friction, bool steady) const {
   SolverSettings s = *this;
   s.gradedRings = gradedRings || annulus;  // NewtonSolver resolves again, knowing no mesh
-  const long most = s.directSolverMaxDofs > 0 ? s.directSolverMaxDofs : annulus ? 50000 : 5000;  // Auto's direct size
+  // Auto's direct size: 50,000 on an annulus; on a box 5,000, and 12,000 for
+  // the monolithic loop (no friction), whose steps a factorisation serves
+  // better than MueLu's V-cycle: G1 2x (10,179 unknowns) 3.48 s with the LU
+  // preconditioner against 4.34 s with MueLu (5.02 s nested), G1 3x (31,863)
+  // 26.7 s against 17.5 s (docs/performance.md, "Defaults and why").
+  const long most = s.directSolverMaxDofs > 0 ? s.directSolverMaxDofs
+                    : annulus                  ? 50000
+                    : s.monolithic && !friction ? 12000
+                                               : 5000;
   if (s.linearSolver == LinearSolver::Auto && steady) {
     // Steady rolling: a factorisation every Newton iteration up to the direct
     // solver's size, as with friction elsewhere (the 3D drive 1.55-1.68 s
