@@ -83,8 +83,9 @@ bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string
   Vector f(m_.u->getMap());
   // Monolithic: a pass is a saddle-point step alone, from the predictor on.
   // A Newton solve on the positions alone comes only after a step that made
-  // no progress, where the constraints are met and the momentum residual is
-  // not, and after kMonolithicPasses passes.
+  // no progress or was halved, from a state no step can start from, where the
+  // constraints are met and the momentum residual is not, and after
+  // kMonolithicPasses passes.
   const bool monolithic = m_.monolithic;
   bool stepNext = monolithic;
   for (int it = 1; it <= maxOuter; ++it) {
