@@ -27,8 +27,6 @@ class SteadyRolling {
  private:
   bool solveStage(double t, const char* what, StepRecord& rec, std::string& failure);
   void holdCores(bool hold);
-  // Coulomb's tangential penalty eps_t times `factor` (1: the scene's).
-  void setStickSoftening(double factor);
   void enableFriction(bool on);
 
   Model& m_;

@@ -60,11 +60,6 @@ void FrictionEffect::setInterval(double tStart, double tEnd) {
   parameters_.v = settings_.regularization * (dt > 0 ? dt : 1.0) * regularisationScale_;
 }
 
-void FrictionEffect::setTangentPenaltyScale(double scale) {
-  parameters_.tangentPenalty =
-      scale * (settings_.tangentialPenalty > 0 ? settings_.tangentialPenalty : contact_.solvePenalty());
-}
-
 void FrictionEffect::setRegularisationScale(double scale) {
   parameters_.v *= scale / regularisationScale_;
   regularisationScale_ = scale;

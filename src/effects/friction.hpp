@@ -22,8 +22,6 @@ class FrictionEffect : public Effect {
   // Tanh and Arctan: the slip scale v is eps3 dt x `scale` (1: the scene's
   // law; src/regularisation_continuation.hpp widens it for a failed solve).
   void setRegularisationScale(double scale);
-  // Coulomb's tangential penalty eps_t, times `scale` from its setting.
-  void setTangentPenaltyScale(double scale);
   // Coulomb with the exact stick/slip corner (Friction/Smoothing = 0): whether
   // a failed solve may be retried through a smoothed corner, and that corner's
   // width for the retry (0: the scene's own again; RegularisationContinuation).
