@@ -318,6 +318,7 @@ void MumpsSolver::analyse(const CrsMatrix& A) {
 
 double MumpsSolver::analyseWith(MumpsOptions::Ordering ordering) {
   Impl& m = *impl_;
+  ++numOrderingAnalyses_;
   DMUMPS_STRUC_C& id = m.id;
   id.perm_in = nullptr;
   switch (ordering) {

@@ -111,6 +111,8 @@ class MumpsSolver {
 
   // Counters (since construction).
   int numAnalyses() const { return numAnalyses_; }
+  // MUMPS analyses run: Ordering = Auto runs two or three for one analysis.
+  int numOrderingAnalyses() const { return numOrderingAnalyses_; }
   int numFactorizations() const { return numFactorizations_; }
   int numWorkspaceRetries() const { return numWorkspaceRetries_; }  // -8/-9 retries
 
@@ -145,7 +147,7 @@ class MumpsSolver {
   MumpsOptions options_;
   std::unique_ptr<Impl> impl_;
   bool analysed_ = false, factored_ = false;
-  int numAnalyses_ = 0, numFactorizations_ = 0, numWorkspaceRetries_ = 0;
+  int numAnalyses_ = 0, numOrderingAnalyses_ = 0, numFactorizations_ = 0, numWorkspaceRetries_ = 0;
   // Ordering = Auto: the winner of the last contest and the entries it was
   // decided on, kept for later analyses while the pattern has grown by less
   // than a tenth (contact or friction entries joining).

@@ -281,6 +281,38 @@ TEST(Mumps, ChangedPatternGetsANewAnalysis) {
   solveAndCheck(solver, *A1, 2);
 }
 
+// Ordering = Auto runs its contest (QAMD, METIS, QAMD again where it won) at
+// the first analysis, and again once the pattern has grown by a tenth or more;
+// a pattern a little larger keeps the winner: one MUMPS analysis.
+TEST(Mumps, AutoOrderingKeepsItsWinnerWhileThePatternGrowsLittle) {
+  auto map = contiguousMap(N, worldComm());
+  auto A = convectionDiffusion(map, ConvDiff{1.0, 0.5, true, 0.0});
+  MumpsSolver solver(testOptions());  // Ordering Auto, the nonzero pattern
+  solver.factor(*A);
+  const int contest = solver.numOrderingAnalyses();
+  EXPECT_GE(contest, 2);
+  EXPECT_LE(contest, 3);
+  // Far couplings turn nonzero in rows below `rows` (each one entry more).
+  auto setFar = [&](GO rows) {
+    A->resumeFill();
+    for (LO l = 0; l < LO(map->getNodeNumElements()); ++l) {
+      const GO g = map->getGlobalElement(l);
+      if (g < rows) A->replaceGlobalValues(g, Teuchos::tuple<GO>(N - 1 - g), Teuchos::tuple<double>(0.3));
+    }
+    A->fillComplete();
+  };
+  setFar(4);  // 4 entries more, under 1%
+  solver.factor(*A);
+  EXPECT_EQ(solver.numAnalyses(), 2);
+  EXPECT_EQ(solver.numOrderingAnalyses(), contest + 1);
+  solveAndCheck(solver, *A, 2);
+  setFar(N);  // every row: more than a tenth
+  solver.factor(*A);
+  EXPECT_EQ(solver.numAnalyses(), 3);
+  EXPECT_GE(solver.numOrderingAnalyses(), contest + 1 + 2);
+  solveAndCheck(solver, *A, 2);
+}
+
 // Zero entries of the graph stay out of MUMPS' pattern (fewer factor
 // entries), join it when they turn nonzero (one more analysis) and stay in it
 // when they are zero again (no analysis).
