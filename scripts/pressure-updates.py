@@ -11,7 +11,8 @@ relative difference of the capstan forces between the two. Writes
 OUT/pressure-updates.csv and OUT/pressure-updates.png (run times, bars).
 
 Usage: scripts/pressure-updates.py [--out out/pressure-updates] [--rounds 3]
-       [--capstan build/capstan] [--cases g1,g2,g3,two,hertz,g1x2]
+       [--capstan build/capstan] [--cases g1,g2,g3,two,hertz]
+       (also "g1x2 LU" and "g1x2 MueLu": G1 2x with each preconditioner)
 """
 import argparse
 import csv

@@ -290,24 +290,25 @@ void MumpsSolver::analyse(const CrsMatrix& A) {
     id.jcn_loc = m.jcn.data();
     id.a_loc = m.a.data();
   }
-  double entries = double(nnz);
-  MPI_Allreduce(MPI_IN_PLACE, &entries, 1, MPI_DOUBLE, MPI_SUM, m.comm);
-  if (options_.ordering == MumpsOptions::Ordering::Auto && autoWinner_ != MumpsOptions::Ordering::Auto &&
-      entries <= 1.1 * autoWinnerEntries_) {
-    // A pattern a little larger than the one the last contest was decided
-    // on keeps its winner: G1 1x 5 MUMPS analyses against 7.
-    analyseWith(autoWinner_);
-  } else if (options_.ordering == MumpsOptions::Ordering::Auto) {
-    // Both analysed, the one whose factorisation the analysis estimates at
-    // fewer flops (RINFOG(1)) kept: QAMD first (the cheaper analysis), then
-    // METIS, and QAMD again only where it won.
-    const double qamd = analyseWith(MumpsOptions::Ordering::Qamd);
-    const double metis = analyseWith(MumpsOptions::Ordering::Metis);
-    int qamdWins = qamd < metis;
-    MPI_Bcast(&qamdWins, 1, MPI_INT, 0, impl_->comm);  // rank 0's figures decide, for every rank alike
-    if (qamdWins) analyseWith(MumpsOptions::Ordering::Qamd);
-    autoWinner_ = qamdWins ? MumpsOptions::Ordering::Qamd : MumpsOptions::Ordering::Metis;
-    autoWinnerEntries_ = entries;
+  if (options_.ordering == MumpsOptions::Ordering::Auto) {
+    double entries = double(nnz);
+    MPI_Allreduce(MPI_IN_PLACE, &entries, 1, MPI_DOUBLE, MPI_SUM, m.comm);
+    if (autoWinner_ != MumpsOptions::Ordering::Auto && entries <= 1.1 * autoWinnerEntries_) {
+      // A pattern a little larger than the one the last contest was decided
+      // on keeps its winner: G1 1x 5 MUMPS analyses against 7.
+      analyseWith(autoWinner_);
+    } else {
+      // Both analysed, the one whose factorisation the analysis estimates at
+      // fewer flops (RINFOG(1)) kept: QAMD first (the cheaper analysis), then
+      // METIS, and QAMD again only where it won.
+      const double qamd = analyseWith(MumpsOptions::Ordering::Qamd);
+      const double metis = analyseWith(MumpsOptions::Ordering::Metis);
+      int qamdWins = qamd < metis;
+      MPI_Bcast(&qamdWins, 1, MPI_INT, 0, impl_->comm);  // rank 0's figures decide, for every rank alike
+      if (qamdWins) analyseWith(MumpsOptions::Ordering::Qamd);
+      autoWinner_ = qamdWins ? MumpsOptions::Ordering::Qamd : MumpsOptions::Ordering::Metis;
+      autoWinnerEntries_ = entries;
+    }
   } else {
     analyseWith(options_.ordering);
   }
