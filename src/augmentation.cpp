@@ -5,9 +5,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <optional>
-
-#include "effect_state.hpp"
 
 namespace capstan {
 
@@ -48,9 +45,6 @@ constexpr double kShortestPressureStep = 1.0 / 16;
 // and 1.48-1.79 s at 1e-5, 180 and 1.85-2.36 s at 1e-6; G1 1x 102, 125 and
 // 143 (19, 17 and 16 steps), 0.20-0.27, 0.22-0.30 and 0.30-0.31 s.
 constexpr double kMonolithicStepTolerance = 1e-4;
-// ... and after this many passes without meeting the tolerances the loop goes
-// on nested (a Newton solve between steps), which converges from further away.
-constexpr int kMonolithicPasses = 12;
 
 json::Object eventOf(const char* name) { return json::Object().add("event", json::string(name)); }
 
@@ -61,8 +55,6 @@ AugmentationLoop::AugmentationLoop(Model& model, Log& log, bool checkTangent)
 
 bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string& failure) {
   const auto& sol = m_.scene.solver;
-  auto& assembly = *m_.assembly;
-  const auto& effects = assembly.effects();
   if (checkTangent_) checkTangent();
   // r0 is capped by the body's force scale c L^2: with a small penalty the bare
   // increment's residual is huge (volume error / eps), and a tolerance relative
@@ -70,56 +62,104 @@ bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string
   const double r0 = std::min(bare, m_.forceScale);
   const double tol = std::max(sol.newtonRelativeTolerance * r0, m_.absTolerance);
   int maxOuter = sol.maxPressureIterations;
-  for (const auto& e : effects) maxOuter = std::max(maxOuter, e->maxAugmentations());
+  for (const auto& e : m_.assembly->effects()) maxOuter = std::max(maxOuter, e->maxAugmentations());
   AndersonMixing mixing(sol.pressureAccelerationDepth, m_.comm);
-  const double polishBelow = m_.pressureStep ? kPolishBelow * tol : m_.absTolerance;
-  // The state before the last saddle-point step, while the pass after it runs.
-  struct StepStart {
-    RCP<Vector> u;
-    EffectState state;                  // the multipliers after their plain update
-    std::vector<double> pressureNext;   // the mixed effects' plain update
-  };
+  PassPolicy passes(m_.monolithic);
   std::optional<StepStart> beforeStep;
   Vector f(m_.u->getMap());
-  // Monolithic: a pass is a saddle-point step alone, from the predictor on.
-  // A Newton solve on the positions alone comes only after a step that made
-  // no progress or was halved, from a state no step can start from, where the
-  // constraints are met and the momentum residual is not, and after
-  // kMonolithicPasses passes.
-  const bool monolithic = m_.monolithic;
-  bool stepNext = monolithic;
   for (int it = 1; it <= maxOuter; ++it) {
-    bool stepOnly = stepNext && it <= kMonolithicPasses;
-    stepNext = monolithic;
-    // Later passes: down to round-off, 1e-3 x the absolute tolerance.
-    double tolIt = tol, passStart = 0;
-    if (it > 1 || stepOnly) {
-      const bool valid = assembly.evaluate(*m_.u, &f, nullptr);
-      passStart = f.norm2();
-      // A state no step can start from (an inverted brick): Newton's to fail.
-      stepOnly = stepOnly && valid && std::isfinite(passStart);
-      tolIt = std::max(std::min(tol, kLaterPassReduction * passStart), 1e-3 * m_.absTolerance);
+    const Pass pass = startPass(it, tol, passes, f);
+    const NewtonResult r = solvePositions(t, pass, beforeStep.has_value(), rec);
+    // A later pass may start below what round-off lets Newton reach; a state
+    // within the absolute tolerance is as converged as it gets.
+    if (!r.converged && !(it > 1 && r.residualNorm <= m_.absTolerance)) {
+      if (beforeStep) {
+        // The saddle-point step's linear model broke down (stick and slip
+        // change over it near the traction limit): back to where it started,
+        // with the plain update instead, rather than a cut step.
+        if (log_.on("newton"))
+          log_.event("newton", format("newton failed (%s) after the pressure step: a plain pass from before it",
+                                      r.failure.c_str()),
+                     eventOf("pressure_step_undone").add("failed_iterations", json::number(r.iterations)));
+        m_.u->update(1.0, *beforeStep->u, 0.0);
+        restoreState(m_.assembly->effects(), beforeStep->state);
+        setMultipliers(m_.assembly->effects(), beforeStep->pressureNext, true);
+        beforeStep.reset();
+        continue;
+      }
+      if (checkTangent_) checkTangent();
+      failure = r.failure;
+      return false;
     }
-    const auto solveStart = Clock::now();
+    beforeStep.reset();
+    // Refresh p(x), v, contact pressures at the converged state.
+    m_.assembly->evaluate(*m_.u, &f, nullptr);
+    Constraints c;
+    if (!checkConstraints(it, rec, c, failure)) return false;
+    // Constraints met: the momentum residual left is Newton's to remove, down
+    // to round-off as the nested loop's last pass does (one polishing step
+    // within the tolerance), so the two loops' answers agree to round-off.
+    if (c.met && pass.stepAlone && pass.start > m_.absTolerance) {
+      passes.newtonNext();
+      continue;
+    }
+    if (c.met) return true;
+    if (m_.pressureStep) {
+      moveByPressureStep(t, f, c, pass.stepAlone, passes, beforeStep, rec);
+      continue;
+    }
+    const auto& effects = m_.assembly->effects();
+    setMultipliers(effects, mixing.next(multipliers(effects, true), multiplierMap(effects, true)), true);
+    // Rolling: contact and friction multipliers within their tolerance stay
+    // put. Moving them anyway (points flicker at the tolerance level as they
+    // pass through the nip) keeps changing the map the pressure loop's mixing
+    // works on, and it stalls. Elsewhere every multiplier moves each pass (a
+    // symmetric problem then stays symmetric to round-off).
+    setMultipliers(effects, multiplierMap(effects, false), false, c.settled);
+  }
+  failure = "augmentation loop did not meet the volume and contact tolerances in " + std::to_string(maxOuter) +
+            " iterations";
+  return false;
+}
+
+AugmentationLoop::Pass AugmentationLoop::startPass(int it, double tol, PassPolicy& passes, Vector& f) {
+  Pass pass;
+  pass.number = it;
+  pass.stepAlone = passes.stepAlone(it);
+  pass.tolerance = tol;
+  if (it == 1 && !pass.stepAlone) return pass;
+  const bool valid = m_.assembly->evaluate(*m_.u, &f, nullptr);
+  pass.start = f.norm2();
+  // A state no step can start from (an inverted brick): Newton's to fail.
+  pass.stepAlone = pass.stepAlone && valid && std::isfinite(pass.start);
+  // Later passes: down to round-off, 1e-3 x the absolute tolerance.
+  pass.tolerance = std::max(std::min(tol, kLaterPassReduction * pass.start), 1e-3 * m_.absTolerance);
+  // A later pass that starts near Newton's tolerance is polished by one
+  // Newton step: Newton to 1e-3 x the absolute tolerance only stagnates where
+  // round-off is above it (8 iterations a step on the rolling slice after
+  // the saddle-point step; on the 3D drive the tolerance is the absolute
+  // one, 1e-13 c L^2, and round-off ~0.7-1.2x it), and how many iterations
+  // it takes first is tipped by round-off. Anderson's mixing needs its map
+  // at converged states: there only passes within the absolute tolerance
+  // (the steady slice under Tanh stalled at 100 passes with 10x Newton's).
+  const double polishBelow = m_.pressureStep ? kPolishBelow * tol : m_.absTolerance;
+  pass.polish = !pass.stepAlone && it > 1 && pass.start <= polishBelow;
+  return pass;
+}
+
+NewtonResult AugmentationLoop::solvePositions(double t, const Pass& pass, bool afterStep, StepRecord& rec) {
+  const auto solveStart = Clock::now();
+  NewtonResult r;
+  if (pass.stepAlone) {
+    r.converged = true, r.residualNorm = pass.start, r.residualHistory = {pass.start};
+  } else {
     // The solve's start, for a retry through wider friction laws or a smoothed
     // stick/slip corner, and in pseudo-time (only kept where there is one).
     const RCP<Vector> start = continuation_.applies() ? rcp(new Vector(*m_.u, Teuchos::Copy)) : Teuchos::null;
-    // A later pass that starts near Newton's tolerance is polished by one
-    // Newton step: Newton to 1e-3 x the absolute tolerance only stagnates where
-    // round-off is above it (8 iterations a step on the rolling slice after
-    // the saddle-point step; on the 3D drive the tolerance is the absolute
-    // one, 1e-13 c L^2, and round-off ~0.7-1.2x it), and how many iterations
-    // it takes first is tipped by round-off. Anderson's mixing needs its map
-    // at converged states: there only passes within the absolute tolerance
-    // (the steady slice under Tanh stalled at 100 passes with 10x Newton's).
-    NewtonResult r;
-    if (stepOnly)
-      r.converged = true, r.residualNorm = passStart, r.residualHistory = {passStart};
-    else
-      r = it > 1 && passStart <= polishBelow ? polish(t, passStart) : m_.newton->solve(*m_.u, tolIt);
+    r = pass.polish ? polish(t, pass.start) : m_.newton->solve(*m_.u, pass.tolerance);
     // (Coulomb's corner retry not after a saddle-point step: undoing the step
-    // is the remedy there, below.)
-    if (!r.converged && continuation_.applies() && (continuation_.regularised() || !beforeStep)) {
+    // is the remedy there, in solve().)
+    if (!r.converged && continuation_.applies() && (continuation_.regularised() || !afterStep)) {
       if (log_.on("newton"))
         log_.event("newton", continuation_.regularised()
                                  ? format("newton failed (%s) in %d iterations: continuation in the friction "
@@ -130,11 +170,11 @@ bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string
       rec.newton += r.iterations;
       rec.linear += r.linearIterations;
       m_.u->update(1.0, *start, 0.0);
-      r = continuation_.solve(*m_.newton, *m_.u, tolIt);
+      r = continuation_.solve(*m_.newton, *m_.u, pass.tolerance);
     }
     // Under a regularised friction law (or Coulomb, below), where the retry failed too and
-    // the failure would cut the increment (below; not a pass after a
-    // saddle-point step, which is undone instead): the solve again from its
+    // the failure would cut the increment (not a pass after a saddle-point
+    // step, which is undone instead): the solve again from its
     // start, in pseudo-time (NewtonSolver::pseudoTransient). Newton's line
     // search only ever lowers |R|, and stops in a local minimum of |R| that is
     // no solution: on H4's soft foundation the friction force's excess over
@@ -148,7 +188,7 @@ bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string
     // H4 at k = 0.01 now lands uncut 4e-3 from its answer in 4x smaller steps
     // (tests/integration/hard_cases.py has that sequence).
     if (!r.converged && (continuation_.regularised() || (continuation_.applies() && everyPointSlips())) &&
-        !(it > 1 && r.residualNorm <= m_.absTolerance) && !beforeStep) {
+        !(pass.number > 1 && r.residualNorm <= m_.absTolerance) && !afterStep) {
       if (log_.on("newton"))
         log_.event("newton", format("newton failed (%s) in %d iterations: pseudo-transient continuation",
                                     r.failure.c_str(), r.iterations),
@@ -156,137 +196,103 @@ bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string
       rec.newton += r.iterations;
       rec.linear += r.linearIterations;
       m_.u->update(1.0, *start, 0.0);
-      r = m_.newton->pseudoTransient(*m_.u, tolIt);
+      r = m_.newton->pseudoTransient(*m_.u, pass.tolerance);
       if (log_.on("newton"))
         log_.event("newton", format("pseudo-transient continuation: %s in %d iterations, |R| %.3e",
                                     r.converged ? "converged" : "failed", r.iterations, r.residualNorm),
                    eventOf("pseudo_transient_end").add("converged", r.converged ? "true" : "false")
                        .add("iterations", json::number(r.iterations)));
     }
-    const double solveSeconds = since(solveStart);
-    rec.newton += r.iterations;
-    rec.linear += r.linearIterations;
-    rec.residual = r.residualNorm;
-    rec.augmentations = it;
-    if (log_.on("newton")) {
-      std::string text = stepOnly ? "saddle-point pass, no Newton solve, |R|:" : "newton |R|:";
-      for (double n : r.residualHistory) text += format(" %.3e", n);
-      if (!r.stepLengths.empty()) {
-        text += "  steps:";
-        for (double a : r.stepLengths) text += format(" %.2g", a);
-      }
-      text += format("  (%d linear; preconditioners built: %d; %.3f s)", r.linearIterations,
-                     m_.newton->preconditionerBuilds(), solveSeconds);
-      std::vector<double> history(r.residualHistory.begin(), r.residualHistory.end());
-      if (log_.on("newton"))
-        log_.event("newton", text,
-                 eventOf("newton").add("pass", json::number(it)).add("residuals", json::array(history))
-                     .add("step_lengths", json::array(r.stepLengths))
-                     .add("converged", r.converged ? "true" : "false")
-                     .add("linear_iterations", json::number(r.linearIterations))
-                     .add("preconditioners_built", json::number(m_.newton->preconditionerBuilds()))
-                     .add("seconds", json::number(solveSeconds)));
+  }
+  rec.newton += r.iterations;
+  rec.linear += r.linearIterations;
+  rec.residual = r.residualNorm;
+  rec.augmentations = pass.number;
+  logPass(pass, r, since(solveStart));
+  return r;
+}
+
+void AugmentationLoop::logPass(const Pass& pass, const NewtonResult& r, double seconds) {
+  if (!log_.on("newton")) return;
+  std::string text = pass.stepAlone ? "saddle-point pass, no Newton solve, |R|:" : "newton |R|:";
+  for (double n : r.residualHistory) text += format(" %.3e", n);
+  if (!r.stepLengths.empty()) {
+    text += "  steps:";
+    for (double a : r.stepLengths) text += format(" %.2g", a);
+  }
+  text += format("  (%d linear; preconditioners built: %d; %.3f s)", r.linearIterations,
+                 m_.newton->preconditionerBuilds(), seconds);
+  std::vector<double> history(r.residualHistory.begin(), r.residualHistory.end());
+  log_.event("newton", text,
+             eventOf("newton").add("pass", json::number(pass.number)).add("residuals", json::array(history))
+                 .add("step_lengths", json::array(r.stepLengths))
+                 .add("converged", r.converged ? "true" : "false")
+                 .add("linear_iterations", json::number(r.linearIterations))
+                 .add("preconditioners_built", json::number(m_.newton->preconditionerBuilds()))
+                 .add("seconds", json::number(seconds)));
+}
+
+bool AugmentationLoop::checkConstraints(int it, StepRecord& rec, Constraints& c, std::string& failure) {
+  auto& assembly = *m_.assembly;
+  for (const auto& e : assembly.effects()) {
+    double v = 0;
+    Teuchos::reduceAll(*m_.comm, Teuchos::REDUCE_MAX, e->constraintViolation(), Teuchos::outArg(v));
+    if (e.get() == &assembly.bricks()) {
+      rec.volumeChange = v, c.volumeMet = v <= e->constraintTolerance();
+      if (m_.pressureStep) m_.pressureStep->measuredAfterNewton(v);
     }
-    // A later pass may start below what round-off lets Newton reach; a state
-    // within the absolute tolerance is as converged as it gets.
-    if (!r.converged && !(it > 1 && r.residualNorm <= m_.absTolerance)) {
-      if (beforeStep) {
-        // The saddle-point step's linear model broke down (stick and slip
-        // change over it near the traction limit): back to where it started,
-        // with the plain update instead, rather than a cut step.
-        if (log_.on("newton"))
-          log_.event("newton", format("newton failed (%s) after the pressure step: a plain pass from before it",
-                                      r.failure.c_str()),
-                     eventOf("pressure_step_undone").add("failed_iterations", json::number(r.iterations)));
-        m_.u->update(1.0, *beforeStep->u, 0.0);
-        restoreState(effects, beforeStep->state);
-        setMultipliers(effects, beforeStep->pressureNext, true);
-        beforeStep.reset();
-        continue;
-      }
-      if (checkTangent_) checkTangent();
-      failure = r.failure;
-      return false;
-    }
-    beforeStep.reset();
-    // Refresh p(x), v, contact pressures at the converged state.
-    assembly.evaluate(*m_.u, &f, nullptr);
-    bool met = true, volumeMet = true, rowsUnmet = false;
-    std::vector<const Effect*> settled;  // plain-updated effects already within tolerance
-    for (const auto& e : effects) {
-      double v = 0;
-      Teuchos::reduceAll(*m_.comm, Teuchos::REDUCE_MAX, e->constraintViolation(), Teuchos::outArg(v));
-      if (e.get() == &assembly.bricks()) {
-        rec.volumeChange = v, volumeMet = v <= e->constraintTolerance();
-        if (m_.pressureStep) m_.pressureStep->measuredAfterNewton(v);
-      }
-      if (log_.on("newton"))
-        log_.event("newton", format("%s: %.3e (tolerance %.1e)", e->constraintName().c_str(), v, e->constraintTolerance()),
+    if (log_.on("newton"))
+      log_.event("newton", format("%s: %.3e (tolerance %.1e)", e->constraintName().c_str(), v, e->constraintTolerance()),
                  eventOf("constraint").add("name", json::string(e->constraintName())).add("violation", json::number(v))
                      .add("tolerance", json::number(e->constraintTolerance())));
-      if (v <= e->constraintTolerance()) {
-        if (m_.rolling) settled.push_back(e.get());
-        continue;
-      }
-      met = false;
-      rowsUnmet = rowsUnmet || e->stepsForItself();
-      if (e->maxAugmentations() > 0 && it >= e->maxAugmentations()) {
-        failure = e->constraintName() + " " + Teuchos::toString(v) + " above its tolerance " +
-                  Teuchos::toString(e->constraintTolerance()) + " after " + std::to_string(it) + " augmentations";
-        return false;
-      }
-    }
-    // Constraints met: the momentum residual left is Newton's to remove, down
-    // to round-off as the nested loop's last pass does (one polishing step
-    // within the tolerance), so the two loops' answers agree to round-off.
-    if (met && stepOnly && passStart > m_.absTolerance) {
-      stepNext = false;
+    if (v <= e->constraintTolerance()) {
+      if (m_.rolling) c.settled.push_back(e.get());
       continue;
     }
-    if (met) return true;
-    if (m_.pressureStep) {
-      // The other multipliers first: the pressure step then re-balances the
-      // body under their new values too, so their change does not spoil the
-      // volumes it makes exact.
-      const std::vector<double> pressureNext = multiplierMap(effects, true);  // at the converged state
-      setMultipliers(effects, multiplierMap(effects, false), false, settled);
-      // Mixed effects other than the bricks (steady friction) take their plain
-      // update here too: the step moves only the rows it has.
-      std::vector<const Effect*> keep = settled;
-      keep.push_back(&assembly.bricks());
-      setMultipliers(effects, pressureNext, true, keep);
-      if (!volumeMet || rowsUnmet) {
-        beforeStep = StepStart{rcp(new Vector(*m_.u, Teuchos::Copy)), saveState(effects), pressureNext};
-        if (!saddlePointPressureStep(t, f, volumeMet, stepOnly, rec)) {  // no progress: a plain pass instead
-          setMultipliers(effects, pressureNext, true);
-          beforeStep.reset();
-          stepNext = false;
-        } else if (stepOnly) {
-          ++rec.newton;  // the monolithic system's Newton iteration
-          // A step its linear model did not carry whole (contact points
-          // entering or leaving): a Newton solve on the positions next, then
-          // steps again. (Tried on the steady drive's frictionless footprint,
-          // from the linear response: without it 12 steps, 7 of them halved,
-          // before the loop went on nested; with it 5 steps, then a Newton
-          // solve, then 2 steps.)
-          if (lastStepShortened_) stepNext = false;
-        }
-      } else {
-        stepNext = false;  // the plain update alone: Newton re-balances the body
-      }
-      continue;
+    c.met = false;
+    c.rowsUnmet = c.rowsUnmet || e->stepsForItself();
+    if (e->maxAugmentations() > 0 && it >= e->maxAugmentations()) {
+      failure = e->constraintName() + " " + Teuchos::toString(v) + " above its tolerance " +
+                Teuchos::toString(e->constraintTolerance()) + " after " + std::to_string(it) + " augmentations";
+      return false;
     }
-    setMultipliers(effects, mixing.next(multipliers(effects, true), multiplierMap(effects, true)), true);
-    // Rolling: contact and friction multipliers within their tolerance stay
-    // put. Moving them anyway (points flicker at the tolerance level as they
-    // pass through the nip) keeps changing the map the pressure loop's mixing
-    // works on, and it stalls. Elsewhere every multiplier moves each pass (a
-    // symmetric problem then stays symmetric to round-off).
-    setMultipliers(effects, multiplierMap(effects, false), false, settled);
   }
-  failure = "augmentation loop did not meet the volume and contact tolerances in " + std::to_string(maxOuter) +
-            " iterations";
-  return false;
+  return true;
+}
+
+void AugmentationLoop::moveByPressureStep(double t, Vector& f, const Constraints& c, bool stepAlone,
+                                          PassPolicy& passes, std::optional<StepStart>& beforeStep,
+                                          StepRecord& rec) {
+  const auto& effects = m_.assembly->effects();
+  // The other multipliers first: the pressure step then re-balances the
+  // body under their new values too, so their change does not spoil the
+  // volumes it makes exact.
+  const std::vector<double> pressureNext = multiplierMap(effects, true);  // at the converged state
+  setMultipliers(effects, multiplierMap(effects, false), false, c.settled);
+  // Mixed effects other than the bricks (steady friction) take their plain
+  // update here too: the step moves only the rows it has.
+  std::vector<const Effect*> keep = c.settled;
+  keep.push_back(&m_.assembly->bricks());
+  setMultipliers(effects, pressureNext, true, keep);
+  if (c.volumeMet && !c.rowsUnmet) {
+    passes.newtonNext();  // the plain update alone: Newton re-balances the body
+    return;
+  }
+  beforeStep = StepStart{rcp(new Vector(*m_.u, Teuchos::Copy)), saveState(effects), pressureNext};
+  if (!saddlePointPressureStep(t, f, c.volumeMet, stepAlone, rec)) {  // no progress: a plain pass instead
+    setMultipliers(effects, pressureNext, true);
+    beforeStep.reset();
+    passes.newtonNext();
+    return;
+  }
+  if (!stepAlone) return;
+  ++rec.newton;  // the monolithic system's Newton iteration
+  // A step its linear model did not carry whole (contact points entering or
+  // leaving): a Newton solve on the positions next, then steps again. (Tried
+  // on the steady drive's frictionless footprint, from the linear response:
+  // without it 12 steps, 7 of them halved, before the loop went on nested;
+  // with it 5 steps, then a Newton solve, then 2 steps.)
+  if (lastStepShortened_) passes.newtonNext();
 }
 
 bool AugmentationLoop::saddlePointPressureStep(double t, Vector& f, bool volumeMet, bool monolithic, StepRecord& rec) {

@@ -3,18 +3,48 @@
 // contact and stick multipliers), then each effect's constraint is checked
 // and the multipliers move: by the saddle-point pressure step
 // (Solver/Pressure Update = Saddle Point) or to their fixed-point map,
-// Anderson-accelerated, until every constraint meets its tolerance.
+// Anderson-accelerated, until every constraint meets its tolerance. With
+// Pressure Update = Monolithic a pass is the saddle-point step alone
+// (PassPolicy says which passes).
 #pragma once
 
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "anderson.hpp"
+#include "effect_state.hpp"
 #include "log.hpp"
 #include "model.hpp"
 #include "regularisation_continuation.hpp"
 #include "step_record.hpp"
 
 namespace capstan {
+
+// Which passes are a saddle-point step alone (Pressure Update = Monolithic:
+// Newton's method on the mixed problem) and which a Newton solve on the
+// positions. Monolithic: steps alone from the predictor on; a Newton solve only
+// after a step that made no progress or was halved, where the constraints are
+// met and the momentum residual is not, and after kMonolithicPasses passes (the
+// nested loop converges from further away). The nested loops: always Newton.
+class PassPolicy {
+ public:
+  static constexpr int kMonolithicPasses = 12;
+  explicit PassPolicy(bool monolithic) : monolithic_(monolithic), stepNext_(monolithic) {}
+  // Whether pass `it` (from 1) is a step alone; the pass after it is one too
+  // unless newtonNext() is called.
+  bool stepAlone(int it) {
+    const bool step = stepNext_ && it <= kMonolithicPasses;
+    stepNext_ = monolithic_;
+    return step;
+  }
+  // The next pass solves Newton on the positions.
+  void newtonNext() { stepNext_ = false; }
+
+ private:
+  bool monolithic_;
+  bool stepNext_;
+};
 
 class AugmentationLoop {
  public:
@@ -28,6 +58,43 @@ class AugmentationLoop {
   bool solve(double t, double bare, StepRecord& rec, std::string& failure);
 
  private:
+  // How a pass starts: a step alone or a Newton solve (or one polishing Newton
+  // step), and the residual it starts from and is to reach.
+  struct Pass {
+    int number = 1;
+    bool stepAlone = false;
+    bool polish = false;
+    double start = 0;      // |R| at the start (0 for a first Newton pass: not evaluated)
+    double tolerance = 0;  // Newton's tolerance in this pass
+  };
+  // The state before the last saddle-point step, while the pass after it runs:
+  // where a pass that fails after the step goes back to.
+  struct StepStart {
+    RCP<Vector> u;
+    EffectState state;                 // the multipliers after their plain update
+    std::vector<double> pressureNext;  // the mixed effects' plain update
+  };
+  // After a converged pass: which constraints are met.
+  struct Constraints {
+    bool met = true;        // all of them
+    bool volumeMet = true;  // the bricks' volumes
+    bool rowsUnmet = false; // some effect with rows of its own in the step (contact, stick) is not
+    std::vector<const Effect*> settled;  // rolling: effects within tolerance, whose multipliers stay put
+  };
+
+  Pass startPass(int it, double tol, PassPolicy& passes, Vector& f);
+  // The pass's Newton solve on the positions (none for a step alone), with
+  // the friction retries (through wider laws, in pseudo-time) where it fails.
+  // afterStep: the pass follows a saddle-point step (which is undone instead).
+  NewtonResult solvePositions(double t, const Pass& pass, bool afterStep, StepRecord& rec);
+  void logPass(const Pass& pass, const NewtonResult& r, double seconds);
+  // Evaluates the constraints at u (converged). False with `failure` set if
+  // an effect ran out of augmentations.
+  bool checkConstraints(int it, StepRecord& rec, Constraints& c, std::string& failure);
+  // The multipliers' move with the saddle-point step: the plain update for
+  // contact and friction, then the step where a constraint with rows is unmet.
+  void moveByPressureStep(double t, Vector& f, const Constraints& c, bool stepAlone, PassPolicy& passes,
+                          std::optional<StepStart>& beforeStep, StepRecord& rec);
   // The saddle-point step at the converged state (src/pressure_step.hpp):
   // moves u and the multipliers together. False if the block solve made no
   // progress (nothing is changed then).

@@ -3,7 +3,7 @@
 // only the topics that are on; the load-step controller with the
 // augmentation loop solves a homogeneous stretch exactly; a failed
 // increment's state comes back as it was; Open MPI's start-up settings keep
-// the user's. Run on 1 and 2 ranks.
+// the user's; the monolithic pass policy. Run on 1 and 2 ranks.
 #include <Tpetra_Core.hpp>
 #include <gtest/gtest.h>
 
@@ -12,6 +12,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "augmentation.hpp"
 #include "checkpoint.hpp"
 #include "effect_state.hpp"
 #include "load_stepper.hpp"
@@ -170,6 +171,22 @@ TEST(LoadStepper, SolvesAHomogeneousStretchExactly) {
 }
 
 // What a failed increment undoes: multipliers and history come back exactly.
+// Monolithic: steps alone until told otherwise, a Newton solve for one pass
+// when told, and nested after PassPolicy::kMonolithicPasses. Nested: never a
+// step alone.
+TEST(PassPolicy, MonolithicStepsAloneUntilANewtonSolveIsAskedFor) {
+  PassPolicy monolithic(true);
+  EXPECT_TRUE(monolithic.stepAlone(1));
+  EXPECT_TRUE(monolithic.stepAlone(2));
+  monolithic.newtonNext();
+  EXPECT_FALSE(monolithic.stepAlone(3));
+  EXPECT_TRUE(monolithic.stepAlone(4));
+  EXPECT_TRUE(monolithic.stepAlone(PassPolicy::kMonolithicPasses));
+  EXPECT_FALSE(monolithic.stepAlone(PassPolicy::kMonolithicPasses + 1));
+  PassPolicy nested(false);
+  for (int it = 1; it <= 3; ++it) EXPECT_FALSE(nested.stepAlone(it));
+}
+
 TEST(EffectState, RestoreUndoesChangedMultipliers) {
   const Scene scene = stretchScene();
   Model model(scene, Tpetra::getDefaultComm());
