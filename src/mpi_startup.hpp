@@ -8,9 +8,11 @@
 //   singleton needs none and can do all capstan does.
 // - Open MPI's cm messaging layer opens its network modules (MTLs); the
 //   Omni-Path one loads libpsm2, whose constructor sleeps about 0.2 s on a
-//   machine without that hardware. Without cm, Open MPI takes ob1 (shared
-//   memory, TCP, UCX), which it picks there anyway. Left alone where an
-//   Omni-Path or InfiniBand device exists or the user names an MTL.
+//   machine without that hardware. Without such a device Open MPI ends with
+//   ob1 (shared memory, TCP) anyway: UCX's layer declines without Mellanox
+//   devices, after loading UCX's libraries (5 ms of every start). So ob1 is
+//   named there; left alone where an Omni-Path or InfiniBand device exists
+//   or the user names a layer or an MTL.
 #pragma once
 
 #include <unistd.h>
@@ -25,7 +27,7 @@ inline bool fastFabricPresent() { return access("/dev/hfi1_0", F_OK) == 0 || acc
 
 inline void setMpiStartupDefaults() {
   if (!launchedByMpiexec()) setenv("OMPI_MCA_ess_singleton_isolated", "1", 0);
-  if (!fastFabricPresent() && !std::getenv("OMPI_MCA_mtl")) setenv("OMPI_MCA_pml", "^cm", 0);
+  if (!fastFabricPresent() && !std::getenv("OMPI_MCA_mtl")) setenv("OMPI_MCA_pml", "ob1", 0);
 }
 
 }  // namespace capstan

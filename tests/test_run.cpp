@@ -209,8 +209,9 @@ TEST(EffectState, RestoreUndoesChangedMultipliers) {
   EXPECT_EQ(multipliers(effects, true), anchors);
 }
 
-// The start-up defaults (src/mpi_startup.hpp) leave Open MPI's cm layer out
-// unless the user names a layer or a network module; a user's setting wins.
+// The start-up defaults (src/mpi_startup.hpp) name Open MPI's ob1 layer
+// unless a fast network device exists or the user names a layer or a network
+// module; a user's setting wins.
 TEST(MpiStartup, DefaultsKeepTheUsersSettings) {
   const char* pml = std::getenv("OMPI_MCA_pml");
   const char* mtl = std::getenv("OMPI_MCA_mtl");
@@ -219,11 +220,11 @@ TEST(MpiStartup, DefaultsKeepTheUsersSettings) {
 
   unsetenv("OMPI_MCA_pml"), unsetenv("OMPI_MCA_mtl");
   setMpiStartupDefaults();
-  EXPECT_EQ(value("OMPI_MCA_pml"), fastFabricPresent() ? "(unset)" : "^cm");
+  EXPECT_EQ(value("OMPI_MCA_pml"), fastFabricPresent() ? "(unset)" : "ob1");
 
-  setenv("OMPI_MCA_pml", "ob1", 1);
+  setenv("OMPI_MCA_pml", "ucx", 1);
   setMpiStartupDefaults();
-  EXPECT_EQ(value("OMPI_MCA_pml"), "ob1");
+  EXPECT_EQ(value("OMPI_MCA_pml"), "ucx");
 
   unsetenv("OMPI_MCA_pml"), setenv("OMPI_MCA_mtl", "psm2", 1);
   setMpiStartupDefaults();
