@@ -1,9 +1,11 @@
 // Steady rolling (formulation.md §8): each load step's steady state, solved
 // from the previous one (a continuation in the loads). The first comes from
-// rest without the user's help, in three solves: the frictionless footprint
-// (from the linear response to the loads, as a quasi-static first step) with
-// each free core's angular velocity held at the no-slip value, then
-// friction at that angular velocity, then the angular velocity let free.
+// rest without the user's help: the frictionless footprint (from the linear
+// response to the loads, as a quasi-static first step) with each free core's
+// angular velocity held at the no-slip value; then, under Coulomb, Tanh laws
+// of falling slip scale with the angular velocity free, whose tractions seed
+// Coulomb's stick multipliers (Tanh and Arctan scenes, or where that fails:
+// friction at the held angular velocity); then the steady state.
 #pragma once
 
 #include <string>
@@ -25,6 +27,11 @@ class SteadyRolling {
   bool solve(double t, StepRecord& rec, std::string& failure);
 
  private:
+  bool startFromRest(double t, StepRecord& rec, std::string& failure);
+  // Coulomb: the Tanh stages from the footprint (kStartSlipScales). False,
+  // with u and the multipliers back at the footprint, if there is no Coulomb
+  // friction or a stage failed.
+  bool startThroughTanh(double t, StepRecord& rec);
   bool solveStage(double t, const char* what, StepRecord& rec, std::string& failure);
   void holdCores(bool hold);
   void enableFriction(bool on);

@@ -98,6 +98,26 @@ SteadyFrictionEffect::SteadyFrictionEffect(const std::string& name, const Mesh& 
   local_.R = Matrix("steady friction R", nf, 3 * kNodes);
 }
 
+void SteadyFrictionEffect::useTanh(double regularization) {
+  if (!tanhStart_) {
+    if (settings_.law != FrictionSettings::Law::Coulomb) throw std::logic_error("steady friction: a Tanh start replaces Coulomb only");
+    sceneRegularization_ = settings_.regularization;
+    tanhStart_ = true;
+  }
+  settings_.law = FrictionSettings::Law::Tanh;
+  settings_.regularization = regularization;
+  parameters_.law = kernels::FrictionLaw::Tanh;
+}
+
+void SteadyFrictionEffect::useCoulomb(bool seed) {
+  if (!tanhStart_) return;
+  tanhStart_ = false;
+  settings_.law = FrictionSettings::Law::Coulomb;
+  settings_.regularization = sceneRegularization_;
+  parameters_.law = kernels::FrictionLaw::Coulomb;
+  if (seed) multiplierMap(tangentialMultipliers_);  // the tractions as lambda_T
+}
+
 void SteadyFrictionEffect::bindCores(const RigidCores& cores) {
   cores_ = &cores;
   core_ = coreName_.empty() ? -1 : cores.find(coreName_);

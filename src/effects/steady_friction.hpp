@@ -48,6 +48,12 @@ class SteadyFrictionEffect : public FrictionEffect {
   void constraintRows(const NodalVectors& x, ConstraintRows& rows) const override;
   // Steady rolling's start: friction off (a frictionless footprint first).
   void setEnabled(bool on) { enabled_ = on; }
+  // Steady rolling's start from rest under Coulomb (src/steady_rolling.cpp):
+  // Tanh of slip scale `regularization` (as Friction/Regularization) in
+  // Coulomb's place; then Coulomb again, with the last evaluation's tractions
+  // as its multipliers where `seed` (else the multipliers are left as they are).
+  void useTanh(double regularization);
+  void useCoulomb(bool seed);
   // The flow's angular velocity scale: the no-slip estimate about +z.
   double referenceAngularVelocity() const { return omegaRef_; }
 
@@ -68,6 +74,8 @@ class SteadyFrictionEffect : public FrictionEffect {
   double axisSign_ = 1;    // the core's axis direction . z
   double sigma_ = 1;       // sign of the flow about +z
   bool enabled_ = true;
+  double sceneRegularization_ = 0;  // while useTanh() holds
+  bool tanhStart_ = false;
 };
 
 }  // namespace capstan

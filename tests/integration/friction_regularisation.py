@@ -22,8 +22,12 @@ to the scene's v, within the increment (no step cut).
     (the shipped h4.xml) converges with no cut through it too;
   * steady rolling, the free slice (pinch-roller-slice-steady.xml) with Tanh at
     Regularization 1e-3 (exit 2 without the continuation): converges with no cut, its
-    speed ratio within 1e-5 of Coulomb's (the scene's own law) and the same stick and
-    slip points.
+    speed ratio within 2e-5 of Coulomb's (the scene's own law, solved to a penetration
+    and stick tolerance of 1e-8, where its answer no longer depends on the solver's
+    path) and the same stick and slip points. Tanh's limit lies 1.6e-5 from Coulomb's
+    answer on this 4x64 ring (0.991081 from eps3 = 1e-3 to 1e-4, against 0.9910655;
+    6.5e-6 on 8x128), and at the default tolerance Coulomb's answer moves by up to
+    2.3e-5 with the path to it (docs/steady-rolling.md).
 """
 import os
 import sys
@@ -125,14 +129,14 @@ for law in ("Tanh", "Arctan"):
 scene = T.input("pinch-roller-slice-steady.xml")
 p, st, out = T.run_scene(scene, "slice steady tanh", sets=[F + "Law=Tanh", F + "Regularization=1e-3"],
                          extra=["--log", "newton"])
-p, sc, _ = T.run_scene(scene, "slice steady coulomb")
+p, sc, _ = T.run_scene(scene, "slice steady coulomb", sets=["Capstans/capstan/Contact/Penetration Tolerance=1e-8"])
 if st and sc and st["converged"] and sc["converged"]:
     T.conforms(out, scene)
     T.check(sum(x["cutbacks"] for x in st["steps"]) == 0, "slice steady tanh: no step cut")
     T.check(len(stages(out)) > 0, "slice steady tanh: the continuation ran")
     a, b = st["steps"][-1], sc["steps"][-1]
     ra, rb = a["supports"]["core"]["speed_ratio"], b["supports"]["core"]["speed_ratio"]
-    T.check(abs(ra - rb) <= 1e-5, f"slice steady: speed ratio Tanh {ra:.7f}, Coulomb {rb:.7f} (1e-5)")
+    T.check(abs(ra - rb) <= 2e-5, f"slice steady: speed ratio Tanh {ra:.7f}, Coulomb {rb:.7f} (2e-5)")
     ca, cb = a["capstans"]["capstan"], b["capstans"]["capstan"]
     T.check((ca["stick_points"], ca["slip_points"]) == (cb["stick_points"], cb["slip_points"]),
             f"slice steady: stick/slip points, Tanh {ca['stick_points']}/{ca['slip_points']}, "
