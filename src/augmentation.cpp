@@ -53,7 +53,7 @@ json::Object eventOf(const char* name) { return json::Object().add("event", json
 AugmentationLoop::AugmentationLoop(Model& model, Log& log, bool checkTangent)
     : m_(model), log_(log), checkTangent_(checkTangent), continuation_(model.assembly->frictions(), log) {}
 
-bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string& failure) {
+bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string& failure, int passLimit) {
   const auto& sol = m_.scene.solver;
   if (checkTangent_) checkTangent();
   // r0 is capped by the body's force scale c L^2: with a small penalty the bare
@@ -106,6 +106,7 @@ bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string
     if (c.met) return true;
     if (m_.pressureStep) {
       moveByPressureStep(t, f, c, pass.stepAlone, passes, beforeStep, rec);
+      if (passLimit > 0 && it >= passLimit) return true;  // a starting guess: the step's state
       continue;
     }
     const auto& effects = m_.assembly->effects();
@@ -116,6 +117,7 @@ bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string
     // works on, and it stalls. Elsewhere every multiplier moves each pass (a
     // symmetric problem then stays symmetric to round-off).
     setMultipliers(effects, multiplierMap(effects, false), false, c.settled);
+    if (passLimit > 0 && it >= passLimit) return true;
   }
   failure = "augmentation loop did not meet the volume and contact tolerances in " + std::to_string(maxOuter) +
             " iterations";

@@ -55,7 +55,10 @@ class AugmentationLoop {
   // residual norm of the bare increment (Newton's tolerance is relative to
   // it). Adds its iterations to rec. False with `failure` set if Newton or
   // the loop failed (u and the multipliers are then the caller's to restore).
-  bool solve(double t, double bare, StepRecord& rec, std::string& failure);
+  // passLimit > 0: the solve ends after that many passes (each a Newton solve
+  // and the multipliers' move) whether the tolerances are met or not: a
+  // starting guess for the next solve (steady rolling's start from rest).
+  bool solve(double t, double bare, StepRecord& rec, std::string& failure, int passLimit = 0);
 
  private:
   // How a pass starts: a step alone or a Newton solve (or one polishing Newton

@@ -32,7 +32,8 @@ class SteadyRolling {
   // with u and the multipliers back at the footprint, if there is no Coulomb
   // friction or a stage failed.
   bool startThroughTanh(double t, StepRecord& rec);
-  bool solveStage(double t, const char* what, StepRecord& rec, std::string& failure);
+  // passLimit > 0: a starting guess, that many augmentation passes.
+  bool solveStage(double t, const char* what, StepRecord& rec, std::string& failure, int passLimit = 0);
   void holdCores(bool hold);
   void enableFriction(bool on);
 
