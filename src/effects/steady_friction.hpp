@@ -50,8 +50,8 @@ class SteadyFrictionEffect : public FrictionEffect {
   void setEnabled(bool on) { enabled_ = on; }
   // Steady rolling's start from rest under Coulomb (src/steady_rolling.cpp):
   // Tanh of slip scale `regularization` (as Friction/Regularization) in
-  // Coulomb's place; then Coulomb again, with the last evaluation's tractions
-  // as its multipliers where `seed` (else the multipliers are left as they are).
+  // Coulomb's place; then Coulomb again, where `seed` with the last
+  // evaluation's tractions as its multipliers (else they are left as they are).
   void useTanh(double regularization);
   void useCoulomb(bool seed);
   // The flow's angular velocity scale: the no-slip estimate about +z.
