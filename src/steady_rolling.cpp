@@ -18,8 +18,10 @@ namespace {
 // angular velocity, the slice 22 against 28, the braked slice 25 against 28
 // and the Carter coating 22 against 32 (docs/steady-rolling.md, "Start from
 // rest"). One scale, 0.2 or 0.1: the braked slice's first solve failed and
-// its step was cut; 0.3: the drive 65. Three, {1, 0.2, 0.05} or {2, 0.5, 0.1}:
-// the drive 66 and 56.
+// its step was cut; 0.3: the drive 65. With one pass per stage (below),
+// {2, 0.4, 0.1} and {1, 0.1} took the drive's brake sweep from rest in 43-44
+// against 66 but the 8x256 braked slice in 24 against 20, the rest within 1-4
+// either way (docs/steady-rolling.md has the table).
 constexpr double kStartSlipScales[] = {1.0, 0.2};
 // The Tanh stages are starting guesses: one pass each, a Newton solve and the
 // saddle-point step (AugmentationLoop::solve's passLimit). The drive 43 Newton
