@@ -22,7 +22,7 @@ namespace {
 // {2, 0.4, 0.1} and {1, 0.1} took the drive's brake sweep from rest in 43-44
 // against 66 but the 8x256 braked slice in 24 against 20, the rest within 1-4
 // either way (docs/steady-rolling.md has the table).
-constexpr double kStartSlipScales[] = {1.0, 0.2};
+constexpr double kStartSlipScales[] = {0.02, 0.004};
 // The Tanh stages are starting guesses: one pass each, a Newton solve and the
 // saddle-point step (AugmentationLoop::solve's passLimit). The drive 43 Newton
 // iterations against 52 with each converged, the slice 18/22, the braked
@@ -39,8 +39,7 @@ SteadyRolling::SteadyRolling(Model& model, Log& log, AugmentationLoop& augmentat
     : m_(model), log_(log), augmentation_(augmentation), predictors_(predictors), started_(started) {}
 
 bool SteadyRolling::solve(double t, StepRecord& rec, std::string& failure) {
-  bool ok = started_ || startFromRest(t, rec, failure);
-  if (ok) ok = solveStage(t, "steady state", rec, failure);
+  const bool ok = started_ ? solveStage(t, "steady state", rec, failure) : startFromRest(t, rec, failure);
   started_ = started_ || ok;
   return ok;
 }
@@ -51,39 +50,46 @@ bool SteadyRolling::startFromRest(double t, StepRecord& rec, std::string& failur
   predictors_.linearResponse(t, rec);
   if (!solveStage(t, "frictionless footprint", rec, failure)) return false;
   enableFriction(true);
-  if (startThroughTanh(t, rec)) return true;
+  const auto coulomb = coulombFrictions();
+  if (!coulomb.empty()) {
+    const auto& effects = m_.assembly->effects();
+    const Vector footprint(*m_.u, Teuchos::Copy);
+    const EffectState atFootprint = saveState(effects);
+    std::string why;
+    if (startThroughTanh(t, coulomb, rec, why) && solveStage(t, "steady state", rec, why)) return true;
+    // Back to the footprint, for the start through friction at the held angular velocity.
+    if (log_.on("newton"))
+      log_.event("newton", format("steady rolling: the start through Tanh failed (%s): from the footprint again",
+                                  why.c_str()),
+                 json::Object().add("event", json::string("steady tanh start failed")));
+    m_.u->update(1.0, footprint, 0.0);
+    restoreState(effects, atFootprint);
+    holdCores(true);
+  }
   if (!solveStage(t, "friction at the no-slip angular velocity", rec, failure)) return false;
   holdCores(false);
-  return true;
+  return solveStage(t, "steady state", rec, failure);
 }
 
-bool SteadyRolling::startThroughTanh(double t, StepRecord& rec) {
+std::vector<SteadyFrictionEffect*> SteadyRolling::coulombFrictions() const {
   std::vector<SteadyFrictionEffect*> coulomb;
   for (auto* f : m_.assembly->frictions())
     if (auto* steady = dynamic_cast<SteadyFrictionEffect*>(f); steady && steady->augmented()) coulomb.push_back(steady);
-  if (coulomb.empty()) return false;
-  const auto& effects = m_.assembly->effects();
-  const Vector footprint(*m_.u, Teuchos::Copy);
-  const EffectState atFootprint = saveState(effects);
+  return coulomb;
+}
+
+bool SteadyRolling::startThroughTanh(double t, const std::vector<SteadyFrictionEffect*>& coulomb, StepRecord& rec,
+                                     std::string& failure) {
   holdCores(false);
-  std::string failure;
   bool ok = true;
   for (double scale : kStartSlipScales) {
     for (auto* f : coulomb) f->useTanh(scale);
-    ok = solveStage(t, format("Tanh of slip scale %g in Coulomb's place", scale).c_str(), rec, failure, kGuessPasses);
+    ok = solveStage(t, format("Tanh of slip speed %g x the capstan's in Coulomb's place", scale).c_str(), rec, failure, kGuessPasses);
     if (!ok) break;
   }
   if (ok) m_.assembly->evaluate(*m_.u, nullptr, nullptr);  // the tractions Coulomb starts from
   for (auto* f : coulomb) f->useCoulomb(ok);
-  if (ok) return true;
-  // Back to the footprint, for the start through friction at the held angular velocity.
-  if (log_.on("newton"))
-    log_.event("newton", format("steady rolling: the start through Tanh failed (%s)", failure.c_str()),
-               json::Object().add("event", json::string("steady tanh start failed")));
-  m_.u->update(1.0, footprint, 0.0);
-  restoreState(effects, atFootprint);
-  holdCores(true);
-  return false;
+  return ok;
 }
 
 bool SteadyRolling::solveStage(double t, const char* what, StepRecord& rec, std::string& failure, int passLimit) {

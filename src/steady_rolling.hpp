@@ -9,6 +9,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "augmentation.hpp"
 #include "log.hpp"
@@ -17,6 +18,8 @@
 #include "step_record.hpp"
 
 namespace capstan {
+
+class SteadyFrictionEffect;
 
 class SteadyRolling {
  public:
@@ -27,11 +30,15 @@ class SteadyRolling {
   bool solve(double t, StepRecord& rec, std::string& failure);
 
  private:
+  // The footprint, then (Coulomb) the Tanh stages and the steady state; where
+  // those fail, from the footprint again through friction at the held
+  // angular velocity, then the steady state.
   bool startFromRest(double t, StepRecord& rec, std::string& failure);
-  // Coulomb: the Tanh stages from the footprint (kStartSlipScales). False,
-  // with u and the multipliers back at the footprint, if there is no Coulomb
-  // friction or a stage failed.
-  bool startThroughTanh(double t, StepRecord& rec);
+  std::vector<SteadyFrictionEffect*> coulombFrictions() const;
+  // Omega free and the Tanh stages (kStartSlipScales) in Coulomb's place;
+  // Coulomb again after them, its multipliers their tractions if they converged.
+  bool startThroughTanh(double t, const std::vector<SteadyFrictionEffect*>& coulomb, StepRecord& rec,
+                        std::string& failure);
   // passLimit > 0: a starting guess, that many augmentation passes.
   bool solveStage(double t, const char* what, StepRecord& rec, std::string& failure, int passLimit = 0);
   void holdCores(bool hold);

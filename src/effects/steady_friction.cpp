@@ -98,7 +98,8 @@ SteadyFrictionEffect::SteadyFrictionEffect(const std::string& name, const Mesh& 
   local_.R = Matrix("steady friction R", nf, 3 * kNodes);
 }
 
-void SteadyFrictionEffect::useTanh(double regularization) {
+void SteadyFrictionEffect::useTanh(double speedFraction) {
+  const double regularization = speedFraction * std::abs(contact_.capstan().angularVelocity * contact_.radius());
   if (!tanhStart_) {
     if (settings_.law != FrictionSettings::Law::Coulomb) throw std::logic_error("steady friction: a Tanh start replaces Coulomb only");
     sceneRegularization_ = settings_.regularization;

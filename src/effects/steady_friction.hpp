@@ -49,10 +49,11 @@ class SteadyFrictionEffect : public FrictionEffect {
   // Steady rolling's start: friction off (a frictionless footprint first).
   void setEnabled(bool on) { enabled_ = on; }
   // Steady rolling's start from rest under Coulomb (src/steady_rolling.cpp):
-  // Tanh of slip scale `regularization` (as Friction/Regularization) in
-  // Coulomb's place; then Coulomb again, where `seed` with the last
+  // Tanh in Coulomb's place, its slip speed scale (Friction/Regularization)
+  // `speedFraction` of the capstan's surface speed (so the start does not
+  // depend on the speed, as Coulomb does not); then Coulomb again, where `seed` with the last
   // evaluation's tractions as its multipliers (else they are left as they are).
-  void useTanh(double regularization);
+  void useTanh(double speedFraction);
   void useCoulomb(bool seed);
   // The flow's angular velocity scale: the no-slip estimate about +z.
   double referenceAngularVelocity() const { return omegaRef_; }
