@@ -31,6 +31,7 @@ SteadyFrictionEffect::SteadyFrictionEffect(const std::string& name, const Mesh& 
                                            const ContactEffect& contact, const FrictionSettings& settings,
                                            const Scene& scene)
     : FrictionEffect(name, mesh, quads, contact, settings) {
+  sceneTangentPenalty_ = parameters_.tangentPenalty;
   for (const auto& s : scene.supports)
     if (s.isCore() && s.face == "inner") coreName_ = s.name, axisSign_ = s.axisDirection[2] > 0 ? 1.0 : -1.0;
   // The no-slip flow about +z: the roller's surface at the capstan's surface speed.

@@ -55,6 +55,9 @@ class SteadyFrictionEffect : public FrictionEffect {
   // evaluation's tractions as its multipliers (else they are left as they are).
   void useTanh(double speedFraction);
   void useCoulomb(bool seed);
+  // Coulomb's tangential penalty eps_t at `factor` x the scene's (the stick's
+  // slope, not where it ends: the multipliers make it exact either way).
+  void softenStick(double factor) { parameters_.tangentPenalty = factor * sceneTangentPenalty_; }
   // The flow's angular velocity scale: the no-slip estimate about +z.
   double referenceAngularVelocity() const { return omegaRef_; }
 
@@ -76,6 +79,7 @@ class SteadyFrictionEffect : public FrictionEffect {
   double sigma_ = 1;       // sign of the flow about +z
   bool enabled_ = true;
   double sceneRegularization_ = 0;  // while useTanh() holds
+  double sceneTangentPenalty_ = 0;
   bool tanhStart_ = false;
 };
 

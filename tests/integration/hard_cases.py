@@ -15,7 +15,11 @@ first order).
   * H1 with the capstan turning 1 rad per step;
   * G1 with eps1 = 1e-13 and 1e-1; with eps2 = 1e-14 (augmented Lagrangian);
   * G1 indented to 0.8 (46% of the height), G2 and G3 to 0.6;
-  * the whole G1 indentation in a single step against 5 steps.
+  * the whole G1 indentation in a single step against 5 steps;
+  * the steady 3D drive at mu = 1.2 (its start from rest fails twice and converges with
+    Coulomb's stick 30x softer: SteadyRolling::startFromRest), against the same scene
+    with a tangential penalty of 3.4e-2 set in the scene, which converges directly; the
+    speed ratios within 2e-5 too.
 """
 import os
 import sys
@@ -27,6 +31,8 @@ from capstan_test import Test, has_nan  # noqa: E402
 T = Test("hard_cases", __doc__)
 FOUND = "Supports/foundation/Stiffness"
 FINE_H = ["Time/Steps=16", "Time/Step Size=0.005"]
+MU12 = "Capstans/capstan/Friction/Coefficient=1.2"
+NOFIELDS = "Output/Write Fields=false"
 
 # name, scene, settings, reference settings, max penetration, Newton budget
 CASES = [
@@ -51,6 +57,8 @@ CASES = [
     ("G2 to 0.6", "seed/g2.xml", ["Time/Steps=6"], ["Time/Steps=12", "Time/Step Size=0.5"], 5e-5, 600),
     ("G3 to 0.6", "seed/g3.xml", ["Time/Steps=6"], ["Time/Steps=12", "Time/Step Size=0.5"], 5e-5, 400),
     ("G1 in one step", "seed/g1.xml", ["Time/Steps=1", "Time/Step Size=5"], [], 5e-5, 300),
+    ("steady drive mu = 1.2", "pinch-roller-steady.xml", [MU12, NOFIELDS], [MU12, NOFIELDS,
+     "Capstans/capstan/Friction/Tangential Penalty=3.4e-2"], 5e-5, 300),
 ]
 
 
@@ -85,4 +93,8 @@ for i, (name, scene, sets, ref_sets, pen_tol, budget, *rest) in enumerate(CASES)
     T.check(newton <= budget, f"{name}: {newton} Newton iterations <= {budget}")
     T.check(diff <= force_tol, f"{name}: final capstan force within {diff:.1e} (<= {force_tol:.0e}) of the finely "
             f"stepped reference")
+    core, ref_core = steps[-1]["supports"].get("core", {}), ref["steps"][-1]["supports"].get("core", {})
+    if "speed_ratio" in core:
+        T.check(abs(core["speed_ratio"] - ref_core["speed_ratio"]) <= 2e-5,
+                f"{name}: speed ratio {core['speed_ratio']:.6f} against {ref_core['speed_ratio']:.6f} (2e-5)")
 T.finish()
