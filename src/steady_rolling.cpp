@@ -31,12 +31,13 @@ constexpr double kStartSlipScales[] = {0.02, 0.004};
 // of it too took the drive to 39, but the 126k drive to 175 s (its first Tanh
 // solve, GMRES with a kept LU, 1,087 Krylov iterations against 184).
 constexpr int kGuessPasses = 1;
-// Where the steady state after the Tanh stages fails, the start is tried again
-// with Coulomb's stick this much softer (eps_t, its tangential penalty), then 3x
-// that. The drive at mu = 1.1-2 failed (the Newton solve stagnated at |R|
+// Where the steady state after the Tanh stages fails, it is solved again from
+// their answer with Coulomb's stick this much softer (eps_t, its tangential
+// penalty), then 3x that. The drive at mu = 1.1-2 failed (the Newton solve stagnated at |R|
 // ~1e-2, and so did friction at the held angular velocity); through the retries
-// mu = 1.1, 1.2, 1.3, 1.5 and 2 converge in 163, 178, 115, 100 and 115 Newton
-// iterations (10x alone left 1.2 failing). Not the default: at 10x the drive's
+// mu = 1.1, 1.2, 1.3, 1.5 and 2 converge in 125, 134, 91, 71 and 82 Newton
+// iterations (10x alone left 1.2 failing; the retries from the footprint,
+// through the Tanh stages again, took 100-178). Not the default: at 10x the drive's
 // brake sweep took up to 25 Newton iterations a step against 15, at 30x 188
 // and a cut.
 constexpr double kRetryStickSoftening = 10;
@@ -64,24 +65,34 @@ bool SteadyRolling::startFromRest(double t, StepRecord& rec, std::string& failur
     const auto& effects = m_.assembly->effects();
     const Vector footprint(*m_.u, Teuchos::Copy);
     const EffectState atFootprint = saveState(effects);
-    for (double softening : {1.0, kRetryStickSoftening, 3 * kRetryStickSoftening}) {
-      std::string why;
-      for (auto* f : coulomb) f->softenStick(softening);
-      bool ok = startThroughTanh(t, coulomb, rec, why) && solveStage(t, "steady state", rec, why);
-      for (auto* f : coulomb) f->softenStick(1.0);
-      // The softer stick's answer is the scene's too (the multipliers make the
-      // stick exact either way); the scene's eps_t from there.
-      if (ok && softening != 1.0) ok = solveStage(t, "steady state, the scene's stick", rec, why);
-      if (ok) return true;
-      // Back to the footprint: the next try starts there.
-      if (log_.on("newton"))
-        log_.event("newton", format("steady rolling: the start through Tanh with the stick %gx softer failed (%s): "
-                                    "from the footprint again", softening, why.c_str()),
-                   json::Object().add("event", json::string("steady tanh start failed")));
-      m_.u->update(1.0, footprint, 0.0);
-      restoreState(effects, atFootprint);
-      holdCores(true);
+    std::string why;
+    if (startThroughTanh(t, coulomb, rec, why)) {
+      const Vector tanh(*m_.u, Teuchos::Copy);
+      const EffectState afterTanh = saveState(effects);
+      for (double softening : {1.0, kRetryStickSoftening, 3 * kRetryStickSoftening}) {
+        for (auto* f : coulomb) f->softenStick(softening);
+        bool ok = solveStage(t, "steady state", rec, why);
+        for (auto* f : coulomb) f->softenStick(1.0);
+        // The softer stick's answer is the scene's too (the multipliers make
+        // the stick exact either way); the scene's eps_t from there.
+        if (ok && softening != 1.0) ok = solveStage(t, "steady state, the scene's stick", rec, why);
+        if (ok) return true;
+        if (log_.on("newton"))
+          log_.event("newton", format("steady rolling: the steady state with the stick %gx softer failed (%s)", softening,
+                                      why.c_str()),
+                     json::Object().add("event", json::string("steady state failed")));
+        m_.u->update(1.0, tanh, 0.0);
+        restoreState(effects, afterTanh);
+      }
     }
+    // Back to the footprint, for the start through friction at the held angular velocity.
+    if (log_.on("newton"))
+      log_.event("newton", format("steady rolling: the start through Tanh failed (%s): from the footprint again",
+                                  why.c_str()),
+                 json::Object().add("event", json::string("steady tanh start failed")));
+    m_.u->update(1.0, footprint, 0.0);
+    restoreState(effects, atFootprint);
+    holdCores(true);
   }
   if (!solveStage(t, "friction at the no-slip angular velocity", rec, failure)) return false;
   holdCores(false);

@@ -30,9 +30,10 @@ class SteadyRolling {
   bool solve(double t, StepRecord& rec, std::string& failure);
 
  private:
-  // The footprint, then (Coulomb) the Tanh stages and the steady state; where
-  // those fail, from the footprint again through friction at the held
-  // angular velocity, then the steady state.
+  // The footprint, then (Coulomb) the Tanh stages and the steady state (where
+  // it fails, again from the Tanh answer with a softer stick,
+  // kRetryStickSoftening); where those fail, from the footprint again through
+  // friction at the held angular velocity, then the steady state.
   bool startFromRest(double t, StepRecord& rec, std::string& failure);
   std::vector<SteadyFrictionEffect*> coulombFrictions() const;
   // Omega free and the Tanh stages (kStartSlipScales) in Coulomb's place;

@@ -16,7 +16,7 @@ first order).
   * G1 with eps1 = 1e-13 and 1e-1; with eps2 = 1e-14 (augmented Lagrangian);
   * G1 indented to 0.8 (46% of the height), G2 and G3 to 0.6;
   * the whole G1 indentation in a single step against 5 steps;
-  * the steady 3D drive at mu = 1.2 (its start from rest fails twice and converges with
+  * the steady 3D drive at mu = 1.2 (its steady state after the Tanh start fails twice and converges with
     Coulomb's stick 30x softer: SteadyRolling::startFromRest), against the same scene
     with a tangential penalty of 3.4e-2 set in the scene, which converges directly; the
     speed ratios within 2e-5 too.
