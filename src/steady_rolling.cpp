@@ -66,25 +66,7 @@ bool SteadyRolling::startFromRest(double t, StepRecord& rec, std::string& failur
     const Vector footprint(*m_.u, Teuchos::Copy);
     const EffectState atFootprint = saveState(effects);
     std::string why;
-    if (startThroughTanh(t, coulomb, rec, why)) {
-      const Vector tanh(*m_.u, Teuchos::Copy);
-      const EffectState afterTanh = saveState(effects);
-      for (double softening : {1.0, kRetryStickSoftening, 3 * kRetryStickSoftening}) {
-        for (auto* f : coulomb) f->softenStick(softening);
-        bool ok = solveStage(t, "steady state", rec, why);
-        for (auto* f : coulomb) f->softenStick(1.0);
-        // The softer stick's answer is the scene's too (the multipliers make
-        // the stick exact either way); the scene's eps_t from there.
-        if (ok && softening != 1.0) ok = solveStage(t, "steady state, the scene's stick", rec, why);
-        if (ok) return true;
-        if (log_.on("newton"))
-          log_.event("newton", format("steady rolling: the steady state with the stick %gx softer failed (%s)", softening,
-                                      why.c_str()),
-                     json::Object().add("event", json::string("steady state failed")));
-        m_.u->update(1.0, tanh, 0.0);
-        restoreState(effects, afterTanh);
-      }
-    }
+    if (startThroughTanh(t, coulomb, rec, why) && steadyStateWithSofterSticks(t, coulomb, rec, why)) return true;
     // Back to the footprint, for the start through friction at the held angular velocity.
     if (log_.on("newton"))
       log_.event("newton", format("steady rolling: the start through Tanh failed (%s): from the footprint again",
@@ -97,6 +79,29 @@ bool SteadyRolling::startFromRest(double t, StepRecord& rec, std::string& failur
   if (!solveStage(t, "friction at the no-slip angular velocity", rec, failure)) return false;
   holdCores(false);
   return solveStage(t, "steady state", rec, failure);
+}
+
+bool SteadyRolling::steadyStateWithSofterSticks(double t, const std::vector<SteadyFrictionEffect*>& coulomb,
+                                                StepRecord& rec, std::string& failure) {
+  const auto& effects = m_.assembly->effects();
+  const Vector tanh(*m_.u, Teuchos::Copy);
+  const EffectState afterTanh = saveState(effects);
+  for (double softening : {1.0, kRetryStickSoftening, 3 * kRetryStickSoftening}) {
+    for (auto* f : coulomb) f->softenStick(softening);
+    bool ok = solveStage(t, "steady state", rec, failure);
+    for (auto* f : coulomb) f->softenStick(1.0);
+    // The softer stick's answer is the scene's too (the multipliers make the
+    // stick exact either way); the scene's eps_t from there.
+    if (ok && softening != 1.0) ok = solveStage(t, "steady state, the scene's stick", rec, failure);
+    if (ok) return true;
+    if (log_.on("newton"))
+      log_.event("newton", format("steady rolling: the steady state with the stick %gx softer failed (%s)", softening,
+                                  failure.c_str()),
+                 json::Object().add("event", json::string("steady state failed")));
+    m_.u->update(1.0, tanh, 0.0);
+    restoreState(effects, afterTanh);
+  }
+  return false;
 }
 
 std::vector<SteadyFrictionEffect*> SteadyRolling::coulombFrictions() const {
