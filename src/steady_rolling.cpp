@@ -33,13 +33,13 @@ constexpr double kStartSlipScales[] = {0.02, 0.004};
 constexpr int kGuessPasses = 1;
 // Where the steady state after the Tanh stages fails, it is solved again from
 // their answer with Coulomb's stick this much softer (eps_t, its tangential
-// penalty), then 3x that. The drive at mu = 1.1-2 failed (the Newton solve stagnated at |R|
-// ~1e-2, and so did friction at the held angular velocity); through the retries
-// mu = 1.1, 1.2, 1.3, 1.5 and 2 converge in 125, 134, 91, 71 and 82 Newton
-// iterations (10x alone left 1.2 failing; the retries from the footprint,
-// through the Tanh stages again, took 100-178). Not the default: at 10x the drive's
-// brake sweep took up to 25 Newton iterations a step against 15, at 30x 188
-// and a cut.
+// penalty), then 3x that. The drive at mu = 1.1-2 failed (the Newton solve
+// stagnated at |R| ~1e-2, and so did friction at the held angular velocity);
+// through the retries mu = 1.1, 1.2, 1.3, 1.5 and 2 converge in 125, 134, 91,
+// 71 and 82 Newton iterations (10x alone left 1.2 failing; retries from the
+// footprint, through the Tanh stages again, took 100-178). Not the default: at
+// 10x the drive's brake sweep took up to 25 Newton iterations a step against
+// 15, at 30x 188 and a cut.
 constexpr double kRetryStickSoftening = 10;
 
 }  // namespace
@@ -117,7 +117,8 @@ bool SteadyRolling::startThroughTanh(double t, const std::vector<SteadyFrictionE
   bool ok = true;
   for (double scale : kStartSlipScales) {
     for (auto* f : coulomb) f->useTanh(scale);
-    ok = solveStage(t, format("Tanh of slip speed %g x the capstan's in Coulomb's place", scale).c_str(), rec, failure, kGuessPasses);
+    const std::string stage = format("Tanh of slip speed %g x the capstan's in Coulomb's place", scale);
+    ok = solveStage(t, stage.c_str(), rec, failure, kGuessPasses);
     if (!ok) break;
   }
   if (ok) m_.assembly->evaluate(*m_.u, nullptr, nullptr);  // the tractions Coulomb starts from

@@ -102,7 +102,8 @@ SteadyFrictionEffect::SteadyFrictionEffect(const std::string& name, const Mesh& 
 void SteadyFrictionEffect::useTanh(double speedFraction) {
   const double regularization = speedFraction * std::abs(contact_.capstan().angularVelocity * contact_.radius());
   if (!tanhStart_) {
-    if (settings_.law != FrictionSettings::Law::Coulomb) throw std::logic_error("steady friction: a Tanh start replaces Coulomb only");
+    if (settings_.law != FrictionSettings::Law::Coulomb)
+      throw std::logic_error("steady friction: a Tanh start replaces Coulomb only");
     sceneRegularization_ = settings_.regularization;
     tanhStart_ = true;
   }

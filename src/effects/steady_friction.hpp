@@ -51,8 +51,9 @@ class SteadyFrictionEffect : public FrictionEffect {
   // Steady rolling's start from rest under Coulomb (src/steady_rolling.cpp):
   // Tanh in Coulomb's place, its slip speed scale (Friction/Regularization)
   // `speedFraction` of the capstan's surface speed (so the start does not
-  // depend on the speed, as Coulomb does not); then Coulomb again, where `seed` with the last
-  // evaluation's tractions as its multipliers (else they are left as they are).
+  // depend on the speed, as Coulomb does not); then Coulomb again, where
+  // `seed` with the last evaluation's tractions as its multipliers (else they
+  // are left as they are).
   void useTanh(double speedFraction);
   void useCoulomb(bool seed);
   // Coulomb's tangential penalty eps_t at `factor` x the scene's (the stick's
