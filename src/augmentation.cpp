@@ -106,18 +106,17 @@ bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string
     if (c.met) return true;
     if (m_.pressureStep) {
       moveByPressureStep(t, f, c, pass.stepAlone, passes, beforeStep, rec);
-      if (passLimit > 0 && it >= passLimit) return true;  // a starting guess: the step's state
-      continue;
+    } else {
+      const auto& effects = m_.assembly->effects();
+      setMultipliers(effects, mixing.next(multipliers(effects, true), multiplierMap(effects, true)), true);
+      // Rolling: contact and friction multipliers within their tolerance stay
+      // put. Moving them anyway (points flicker at the tolerance level as they
+      // pass through the nip) keeps changing the map the pressure loop's mixing
+      // works on, and it stalls. Elsewhere every multiplier moves each pass (a
+      // symmetric problem then stays symmetric to round-off).
+      setMultipliers(effects, multiplierMap(effects, false), false, c.settled);
     }
-    const auto& effects = m_.assembly->effects();
-    setMultipliers(effects, mixing.next(multipliers(effects, true), multiplierMap(effects, true)), true);
-    // Rolling: contact and friction multipliers within their tolerance stay
-    // put. Moving them anyway (points flicker at the tolerance level as they
-    // pass through the nip) keeps changing the map the pressure loop's mixing
-    // works on, and it stalls. Elsewhere every multiplier moves each pass (a
-    // symmetric problem then stays symmetric to round-off).
-    setMultipliers(effects, multiplierMap(effects, false), false, c.settled);
-    if (passLimit > 0 && it >= passLimit) return true;
+    if (passLimit > 0 && it >= passLimit) return true;  // a starting guess: the moved state
   }
   failure = "augmentation loop did not meet the volume and contact tolerances in " + std::to_string(maxOuter) +
             " iterations";

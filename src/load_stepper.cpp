@@ -30,21 +30,19 @@ bool LoadStepper::advance(StepRecord& rec, std::string& failure) {
   m_.newton->rebuildPreconditioner();
   double h = rec.time - tDone_;
   // The step's start: a failed step's converged sub-steps are not outputs.
-  Vector uStep(*m_.u, Teuchos::Copy);
-  const auto stateStep = saveState(effects);
+  const auto atStep = m_.snapshot();
   const double tStep = tDone_;
   while (tDone_ < rec.time - 1e-12 * dt) {
     const double tEnd = std::min(tDone_ + h, rec.time);
     // The cores' records from u: a failed attempt left them at its last trial,
     // and the rotations saved here give the next sub-step's turn (Predictors).
     assembly.applyConstraints(*m_.u, tDone_);
-    Vector uSaved(*m_.u, Teuchos::Copy);
-    const auto stateSaved = saveState(effects);
+    const auto saved = m_.snapshot();
     std::vector<double> rotationsSaved;
     for (const auto& core : assembly.rigidCores()) rotationsSaved.push_back(core.rotation);
     std::string why;
     if (solveIncrement(tDone_, tEnd, rec, why)) {
-      predictors_.remember(uSaved, tDone_, rotationsSaved);
+      predictors_.remember(saved.u, tDone_, rotationsSaved);
       tDone_ = tEnd;
       // History (friction) moves on to this converged state; the step's
       // last sub-step commits after the step's figures are taken, which
@@ -54,16 +52,14 @@ bool LoadStepper::advance(StepRecord& rec, std::string& failure) {
       h = std::min(2 * h, rec.time - tDone_);
       continue;
     }
-    m_.u->update(1.0, uSaved, 0.0);
-    restoreState(effects, stateSaved);
+    m_.restore(saved);
     ++rec.cutbacks;
     h /= 2;
     log_.progress(format("  step %d: cut back to dt = %.4g (%s)", rec.step, h, why.c_str()));
     if (h < dt * kMinimumSubstep) {
       failure = "step " + std::to_string(rec.step) + " failed at minimum step size " +
                 Teuchos::toString(dt * kMinimumSubstep) + ": " + why + brakeDiagnosis(m_.scene);
-      m_.u->update(1.0, uStep, 0.0);
-      restoreState(effects, stateStep);
+      m_.restore(atStep);
       tDone_ = tStep;
       assembly.setInterval(tDone_, tDone_);
       return false;

@@ -40,6 +40,17 @@ struct Model {
   long numContactFaces = 0; // global, each candidate face once
 
   const EffectList& effects() const { return assembly->effects(); }
+  // A state to go back to (a failed increment, a failed start): u and the
+  // effects' multipliers and history.
+  struct Snapshot {
+    Vector u;
+    EffectState effects;
+  };
+  Snapshot snapshot() const { return {Vector(*u, Teuchos::Copy), saveState(effects())}; }
+  void restore(const Snapshot& s) {
+    u->update(1.0, s.u, 0.0);
+    restoreState(effects(), s.effects);
+  }
   // Newton's linear solves and the pressure steps' block solves.
   double linearSolveSeconds() const;
 };

@@ -3,7 +3,6 @@
 #include <cmath>
 #include <limits>
 
-#include "effect_state.hpp"
 #include "effects/steady_friction.hpp"
 #include "rolling.hpp"
 
@@ -62,9 +61,7 @@ bool SteadyRolling::startFromRest(double t, StepRecord& rec, std::string& failur
   enableFriction(true);
   const auto coulomb = coulombFrictions();
   if (!coulomb.empty()) {
-    const auto& effects = m_.assembly->effects();
-    const Vector footprint(*m_.u, Teuchos::Copy);
-    const EffectState atFootprint = saveState(effects);
+    const auto footprint = m_.snapshot();
     std::string why;
     if (startThroughTanh(t, coulomb, rec, why) && steadyStateWithSofterSticks(t, coulomb, rec, why)) return true;
     // Back to the footprint, for the start through friction at the held angular velocity.
@@ -72,8 +69,7 @@ bool SteadyRolling::startFromRest(double t, StepRecord& rec, std::string& failur
       log_.event("newton", format("steady rolling: the start through Tanh failed (%s): from the footprint again",
                                   why.c_str()),
                  json::Object().add("event", json::string("steady tanh start failed")));
-    m_.u->update(1.0, footprint, 0.0);
-    restoreState(effects, atFootprint);
+    m_.restore(footprint);
     holdCores(true);
   }
   if (!solveStage(t, "friction at the no-slip angular velocity", rec, failure)) return false;
@@ -83,9 +79,7 @@ bool SteadyRolling::startFromRest(double t, StepRecord& rec, std::string& failur
 
 bool SteadyRolling::steadyStateWithSofterSticks(double t, const std::vector<SteadyFrictionEffect*>& coulomb,
                                                 StepRecord& rec, std::string& failure) {
-  const auto& effects = m_.assembly->effects();
-  const Vector tanh(*m_.u, Teuchos::Copy);
-  const EffectState afterTanh = saveState(effects);
+  const auto afterTanh = m_.snapshot();
   for (double softening : {1.0, kRetryStickSoftening, 3 * kRetryStickSoftening}) {
     for (auto* f : coulomb) f->softenStick(softening);
     bool ok = solveStage(t, "steady state", rec, failure);
@@ -98,8 +92,7 @@ bool SteadyRolling::steadyStateWithSofterSticks(double t, const std::vector<Stea
       log_.event("newton", format("steady rolling: the steady state with the stick %gx softer failed (%s)", softening,
                                   failure.c_str()),
                  json::Object().add("event", json::string("steady state failed")));
-    m_.u->update(1.0, tanh, 0.0);
-    restoreState(effects, afterTanh);
+    m_.restore(afterTanh);
   }
   return false;
 }
