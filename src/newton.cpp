@@ -1,19 +1,13 @@
 #include "newton.hpp"
 
-#include <Ifpack2_Factory.hpp>
 #include <Kokkos_Timer.hpp>
 #include <NOX.H>
 #include <NOX_Observer.hpp>
 #include <NOX_Solver_LineSearchBased.H>
 #include <NOX_Thyra.H>
 #include <NOX_Thyra_Group.H>
-#include <Stratimikos_DefaultLinearSolverBuilder.hpp>
-#include <Stratimikos_MueLuHelpers.hpp>
-#include "mumps_solve_factory.hpp"
-#include <Teuchos_AbstractFactoryStd.hpp>
 #include <Teuchos_oblackholestream.hpp>
 #include <Thyra_DefaultLinearOpSource.hpp>
-#include <Thyra_Ifpack2PreconditionerFactory.hpp>
 #include <Thyra_LinearOpWithSolveFactoryHelpers.hpp>
 #include <Thyra_StateFuncModelEvaluatorBase.hpp>
 #include <Thyra_TpetraThyraWrappers.hpp>
@@ -22,6 +16,7 @@
 #include <cstdio>
 
 #include "errors.hpp"
+#include "linear_solver_factories.hpp"
 
 namespace capstan {
 
@@ -429,16 +424,6 @@ NewtonSolver::NewtonSolver(Assembly& assembly, const SolverSettings& settings)
     : impl_(std::make_unique<Impl>(assembly, settings.resolved(long(assembly.dofMap()->getGlobalNumElements()),
                                                                 false, false))) {
   const SolverSettings& solver = impl_->solver;
-  Stratimikos::DefaultLinearSolverBuilder builder;
-  using PrecBase = Thyra::PreconditionerFactoryBase<double>;
-  using Ifpack2Factory = Thyra::Ifpack2PreconditionerFactory<Tpetra::CrsMatrix<>>;
-  builder.setPreconditioningStrategyFactory(Teuchos::abstractFactoryStd<PrecBase, Ifpack2Factory>(),
-                                            "Ifpack2");
-  Stratimikos::enableMueLu(builder);
-  builder.setLinearSolveStrategyFactory(
-      Teuchos::abstractFactoryStd<Thyra::LinearOpWithSolveFactoryBase<double>, MumpsSolveFactory>(), "MUMPS");
-  builder.setPreconditioningStrategyFactory(Teuchos::abstractFactoryStd<PrecBase, MumpsPreconditionerFactory>(),
-                                            "MUMPS");
   const int ranks = assembly.dofMap()->getComm()->getSize();
   impl_->strat = stratimikosParameters(solver, ranks,
                                        solver.preconditioner != SolverSettings::Preconditioner::ILU &&
@@ -450,9 +435,9 @@ NewtonSolver::NewtonSolver(Assembly& assembly, const SolverSettings& settings)
   // starts: Stratimikos validates its list, and building a NOX solver once
   // checks NOX's choices (solver, direction, line search names).
   try {
-    builder.setParameterList(Teuchos::rcp(new Teuchos::ParameterList(impl_->strat)));
-    impl_->lows = builder.createLinearSolveStrategy("");
-    auto prec = builder.createPreconditioningStrategy("");
+    auto factories = linearSolverFactories(impl_->strat);
+    impl_->lows = factories.lows;
+    auto prec = factories.prec;
     if (!prec.is_null() && impl_->lows->acceptsPreconditionerFactory()) {
       // The predictor's one solve per step builds its own preconditioner;
       // Newton's may be kept across iterations (Solver/Preconditioner Reuse).
@@ -465,6 +450,8 @@ NewtonSolver::NewtonSolver(Assembly& assembly, const SolverSettings& settings)
         impl_->lag = std::make_unique<LagPolicy>(*impl_->newtonPrecFactory, solver.maxLinearIterations,
                                                  2.0, 10);
     }
+  } catch (const PluginError&) {
+    throw;
   } catch (const std::exception& e) {
     throw InputError("parameter 'Solver/Stratimikos': " + trilinosMessage(e.what()));
   }
@@ -481,9 +468,11 @@ NewtonSolver::NewtonSolver(Assembly& assembly, const SolverSettings& settings)
       auto K = assembly.createMatrix();
       assembly.evaluate(zero, nullptr, K.get());
       RCP<const Thyra::LinearOpBase<double>> op = Thyra::createConstLinearOp(RCP<const Tpetra::Operator<>>(K));
-      auto factory = builder.createPreconditioningStrategy("");
+      auto factory = linearSolverFactories(impl_->strat).prec;
       auto trial = factory->createPrec();
       factory->initializePrec(Thyra::defaultLinearOpSource<double>(op), trial.get());
+    } catch (const PluginError&) {
+      throw;
     } catch (const std::exception& e) {
       std::string what = e.what();
       what = what.substr(0, what.find("The valid parameters and types are"));  // a page of them

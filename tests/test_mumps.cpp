@@ -18,11 +18,15 @@
 #include <string>
 #include <vector>
 
+#include <Thyra_DefaultLinearOpSource.hpp>
 #include <Thyra_LinearOpWithSolveBase.hpp>
 #include <Thyra_LinearOpWithSolveFactoryHelpers.hpp>
 #include <Thyra_TpetraThyraWrappers.hpp>
 
+#include <dlfcn.h>
+
 #include "direct_solver.hpp"
+#include "linear_solver_factories.hpp"
 #include "mumps_solve_factory.hpp"
 
 using namespace capstan;
@@ -193,6 +197,90 @@ TEST(MumpsThyra, OperatorsShareTheAnalysisAndSolveWithTheirOwnValues) {
   auto negative = Teuchos::parameterList();  // so is a negative size
   negative->set("Host Only Below", -1);
   EXPECT_THROW(factory->setParameterList(negative), std::invalid_argument);
+}
+
+// GMRES with the MUMPS preconditioner and the direct solve are built without
+// Stratimikos' builder (no MueLu, Ifpack2 or Stratimikos library loaded), and
+// give what the builder in the krylov plugin gives for the same list.
+TEST(LinearSolverFactories, BuiltInListsMatchTheBuilderWithoutLoadingIt) {
+  using capstan::builtWithoutStratimikos;
+  using capstan::linearSolverFactories;
+  using Converter = Thyra::TpetraOperatorVectorExtraction<double>;
+  Teuchos::ParameterList direct;
+  direct.set("Linear Solver Type", "MUMPS");
+  direct.set("Preconditioner Type", "None");
+  Teuchos::ParameterList gmres;
+  gmres.set("Linear Solver Type", "Belos");
+  gmres.set("Preconditioner Type", "MUMPS");
+  auto& belos = gmres.sublist("Linear Solver Types").sublist("Belos");
+  belos.set("Solver Type", "Block GMRES");
+  belos.sublist("Solver Types").sublist("Block GMRES").set("Convergence Tolerance", 1e-13);
+  gmres.sublist("Preconditioner Types").sublist("MUMPS").set("Ordering", "AMD");
+  EXPECT_TRUE(builtWithoutStratimikos(direct));
+  EXPECT_TRUE(builtWithoutStratimikos(gmres));
+  auto other = [](Teuchos::ParameterList p, const std::string& path, const std::string& value) {
+    if (path.find('/') == std::string::npos) p.set(path, value);
+    else p.sublist(path.substr(0, path.find('/'))).sublist(path.substr(path.find('/') + 1));
+    return p;
+  };
+  EXPECT_FALSE(builtWithoutStratimikos(other(gmres, "Preconditioner Type", "MueLu")));
+  EXPECT_FALSE(builtWithoutStratimikos(other(gmres, "Preconditioner Type", "Ifpack2")));
+  EXPECT_FALSE(builtWithoutStratimikos(other(direct, "Preconditioner Type", "MUMPS")));
+  EXPECT_FALSE(builtWithoutStratimikos(other(gmres, "Linear Solver Type", "Amesos2")));
+  EXPECT_FALSE(builtWithoutStratimikos(other(gmres, "Enable Delayed Solver Construction", "x")));
+  EXPECT_FALSE(builtWithoutStratimikos(other(gmres, "Linear Solver Types/AztecOO", "")));
+  EXPECT_FALSE(builtWithoutStratimikos(other(direct, "Preconditioner Types/MUMPS", "")));
+
+  const bool builderLoadedBefore = dlopen("libtrilinos_stratimikos.so.13.2", RTLD_NOW | RTLD_NOLOAD) != nullptr;
+  auto map = contiguousMap(N, worldComm());
+  auto A = convectionDiffusion(map, ConvDiff{});
+  auto op = Thyra::createConstLinearOp(Teuchos::rcp_implicit_cast<const Tpetra::Operator<>>(A));
+  auto xTrue = knownSolution(map, 1);
+  auto b = rcp(new MultiVector(map, 1));
+  A->apply(*xTrue, *b);
+  auto space = Thyra::createVectorSpace<double>(map);
+  auto solve = [&](const capstan::LinearSolverFactories& f, int& iterations) {
+    auto x = rcp(new MultiVector(map, 1));
+    RCP<Thyra::LinearOpWithSolveBase<double>> lows;
+    if (f.prec.is_null()) {
+      lows = Thyra::linearOpWithSolve<double>(*f.lows, op);
+    } else {
+      auto prec = f.prec->createPrec();
+      f.prec->initializePrec(Thyra::defaultLinearOpSource<double>(op), prec.get());
+      lows = f.lows->createOp();
+      f.lows->initializePreconditionedOp(Thyra::defaultLinearOpSource<double>(op), prec, lows.get());
+    }
+    auto xt = Thyra::createMultiVector(x, space);
+    const auto status = Thyra::solve<double>(*lows, Thyra::NOTRANS,
+                                             *Thyra::createConstMultiVector(RCP<const MultiVector>(b), space), xt.ptr());
+    EXPECT_EQ(status.solveStatus, Thyra::SOLVE_STATUS_CONVERGED);
+    iterations = status.extraParameters.is_null() ? 0 : status.extraParameters->get("Iteration Count", 0);
+    return Converter::getTpetraMultiVector(xt);
+  };
+  int directIts = -1, gmresIts = -1, pluginIts = -1;
+  auto xDirect = solve(linearSolverFactories(direct), directIts);
+  auto xGmres = solve(linearSolverFactories(gmres), gmresIts);
+  if (!builderLoadedBefore) {
+    EXPECT_EQ(dlopen("libtrilinos_stratimikos.so.13.2", RTLD_NOW | RTLD_NOLOAD), nullptr)
+        << "a built-in list loaded Stratimikos' builder";
+  }
+  // The same GMRES list through the builder (an unused sublist sends it there).
+  auto viaBuilder = linearSolverFactories(other(gmres, "Linear Solver Types/AztecOO", ""));
+  EXPECT_NE(dlopen("libtrilinos_stratimikos.so.13.2", RTLD_NOW | RTLD_NOLOAD), nullptr);
+  auto xPlugin = solve(viaBuilder, pluginIts);
+  EXPECT_EQ(gmresIts, pluginIts);
+  EXPECT_GE(gmresIts, 1);
+  for (const auto& x : {xDirect, xGmres, xPlugin}) {
+    MultiVector e(*xTrue, Teuchos::Copy);
+    e.update(1.0, *x, -1.0);
+    std::vector<double> en(1);
+    e.normInf(en);
+    EXPECT_LT(en[0], 1e-10);
+  }
+  // A bad value in a built-in list is still an error naming it.
+  auto bad = gmres;
+  bad.sublist("Preconditioner Types").sublist("MUMPS").set("Ordering", "Nested");
+  EXPECT_THROW(linearSolverFactories(bad), std::invalid_argument);
 }
 
 TEST(Mumps, EveryOrderingSolves) {
