@@ -1,6 +1,8 @@
 // Newton's method for the assembled residual: NOX (line search Newton) on a
-// Thyra model evaluator, linear solves by Stratimikos (Belos + Ifpack2, or
-// Amesos2). The only file that includes the heavy Trilinos solver headers.
+// Thyra model evaluator, linear solves by the factories of
+// src/linear_solver_factories.hpp (MUMPS, Belos + MUMPS, or Stratimikos' builder
+// in the krylov plugin). newton.cpp and that file include NOX's and Thyra's heavy
+// headers; the plugin includes Stratimikos', Ifpack2's and MueLu's.
 #pragma once
 
 #include <Teuchos_ParameterList.hpp>
