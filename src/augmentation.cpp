@@ -81,8 +81,7 @@ bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string
           log_.event("newton", format("newton failed (%s) after the pressure step: a plain pass from before it",
                                       r.failure.c_str()),
                      eventOf("pressure_step_undone").add("failed_iterations", json::number(r.iterations)));
-        m_.u->update(1.0, *beforeStep->u, 0.0);
-        restoreState(m_.assembly->effects(), beforeStep->state);
+        m_.restore(beforeStep->at);
         setMultipliers(m_.assembly->effects(), beforeStep->pressureNext, true);
         beforeStep.reset();
         continue;
@@ -279,7 +278,7 @@ void AugmentationLoop::moveByPressureStep(double t, Vector& f, const Constraints
     passes.newtonNext();  // the plain update alone: Newton re-balances the body
     return;
   }
-  beforeStep = StepStart{rcp(new Vector(*m_.u, Teuchos::Copy)), saveState(effects), pressureNext};
+  beforeStep = StepStart{m_.snapshot(), pressureNext};
   if (!saddlePointPressureStep(t, f, c.volumeMet, stepAlone, rec)) {  // no progress: a plain pass instead
     setMultipliers(effects, pressureNext, true);
     beforeStep.reset();

@@ -73,8 +73,7 @@ class AugmentationLoop {
   // The state before the last saddle-point step, while the pass after it runs:
   // where a pass that fails after the step goes back to.
   struct StepStart {
-    RCP<Vector> u;
-    EffectState state;                 // the multipliers after their plain update
+    Model::Snapshot at;                // u, and the multipliers after their plain update
     std::vector<double> pressureNext;  // the mixed effects' plain update
   };
   // After a converged pass: which constraints are met.
