@@ -1,5 +1,7 @@
 #include "load_stepper.hpp"
 
+#include <algorithm>
+
 #include "effect_state.hpp"
 #include "rolling.hpp"
 
@@ -8,6 +10,18 @@ namespace capstan {
 namespace {
 // The smallest sub-step, as a fraction of Time/Step Size: ten halvings.
 constexpr double kMinimumSubstep = 1.0 / 1024;
+
+// How long after t the cores' external loads (forces, torques) still ramp: 0
+// once all are in.
+double loadRampLeft(const Assembly& assembly, double t) {
+  double left = 0;
+  for (const auto& core : assembly.rigidCores()) {
+    const bool force = core.force[0] != 0 || core.force[1] != 0 || core.force[2] != 0;
+    if (force && core.rampTime > t) left = std::max(left, core.rampTime - t);
+    if (core.torque != 0 && core.torqueRampTime > t) left = std::max(left, core.torqueRampTime - t);
+  }
+  return left;
+}
 }  // namespace
 
 LoadStepper::LoadStepper(Model& model, Log& log, bool checkTangent, double tDone)
@@ -25,6 +39,11 @@ bool LoadStepper::advance(StepRecord& rec, std::string& failure) {
   auto& assembly = *m_.assembly;
   const auto& effects = assembly.effects();
   const double dt = m_.scene.stepSize;
+  const bool steady = m_.scene.analysis.steady();
+  // Steady rolling halves the loads' span instead of the step where they ramp
+  // within it (below).
+  const double rampAtStart = steady ? loadRampLeft(assembly, tDone_) : 0;
+  const double minimumSubstep = kMinimumSubstep * (rampAtStart > 0 ? std::min(dt, rampAtStart) : dt);
   // A reused preconditioner starts each step afresh, so a run restarted at
   // any step repeats the uninterrupted run's arithmetic exactly.
   m_.newton->rebuildPreconditioner();
@@ -55,10 +74,16 @@ bool LoadStepper::advance(StepRecord& rec, std::string& failure) {
     m_.restore(saved);
     ++rec.cutbacks;
     h /= 2;
+    // A steady state depends on the time only through the loads: a cut is a
+    // continuation in them, so a sub-step ends before they are all in (the
+    // steady drive pressed 8x harder than shipped, its force ramped in 1e-6 s
+    // of a 1e-3 s step: half the force first; docs/steady-rolling.md).
+    const double rampLeft = steady ? loadRampLeft(assembly, tDone_) : 0;
+    if (rampLeft > 0 && h >= rampLeft) h = rampLeft / 2;
     log_.progress(format("  step %d: cut back to dt = %.4g (%s)", rec.step, h, why.c_str()));
-    if (h < dt * kMinimumSubstep) {
+    if (h < minimumSubstep) {
       failure = "step " + std::to_string(rec.step) + " failed at minimum step size " +
-                Teuchos::toString(dt * kMinimumSubstep) + ": " + why + brakeDiagnosis(m_.scene);
+                Teuchos::toString(minimumSubstep) + ": " + why + brakeDiagnosis(m_.scene);
       m_.restore(atStep);
       tDone_ = tStep;
       assembly.setInterval(tDone_, tDone_);
