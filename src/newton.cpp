@@ -491,7 +491,7 @@ NewtonSolver::NewtonSolver(Assembly& assembly, const SolverSettings& settings)
 
 NewtonSolver::~NewtonSolver() = default;
 
-int NewtonSolver::linearSolve(const Vector& b, Vector& x, double tolerance) {
+int NewtonSolver::linearSolve(const Vector& b, Vector& x, double tolerance, bool keptPreconditioner) {
   Kokkos::Timer timer;
   RCP<const Thyra::LinearOpBase<double>> W = impl_->W;
   auto space = impl_->model->get_x_space();
@@ -499,7 +499,16 @@ int NewtonSolver::linearSolve(const Vector& b, Vector& x, double tolerance) {
   auto xt = Thyra::createVector(Teuchos::rcpFromRef(x), space);
   int iterations = -1;
   try {  // the factorisation (a direct solver's) happens here, and fails on a singular W
-    auto lows = Thyra::linearOpWithSolve(*impl_->lows, W);
+    RCP<Thyra::LinearOpWithSolveBase<double>> lows;
+    if (keptPreconditioner && !impl_->newtonPrecFactory.is_null()) {
+      impl_->newtonPrecFactory->initializePrec(Thyra::defaultLinearOpSource<double>(W), impl_->prec.get(),
+                                               Thyra::SUPPORT_SOLVE_UNSPECIFIED);
+      lows = impl_->lows->createOp();
+      impl_->lows->initializePreconditionedOp(Thyra::defaultLinearOpSource<double>(W), impl_->prec, lows.get(),
+                                              Thyra::SUPPORT_SOLVE_UNSPECIFIED);
+    } else {
+      lows = Thyra::linearOpWithSolve(*impl_->lows, W);
+    }
     Thyra::SolveCriteria<double> criteria;
     criteria.solveMeasureType = Thyra::SolveMeasureType(Thyra::SOLVE_MEASURE_NORM_RESIDUAL, Thyra::SOLVE_MEASURE_NORM_RHS);
     criteria.requestedTol = tolerance;

@@ -54,8 +54,10 @@ class NewtonSolver {
   // assembled it, and the configured solver with a preconditioner of its own
   // (x: initial guess in, solution out), to the relative residual `tolerance`
   // (Krylov solvers). Newton reassembles W before it next solves.
+  // `keptPreconditioner`: precondition with the one Newton keeps (Preconditioner
+  // Reuse; built now if none is) instead of a new one.
   // Returns the Krylov iterations, or -1 if it failed.
-  int linearSolve(const Vector& b, Vector& x, double tolerance);
+  int linearSolve(const Vector& b, Vector& x, double tolerance, bool keptPreconditioner = false);
   // Newton's next linear solve builds a new preconditioner (with Solver/
   // Preconditioner Reuse = Adaptive it is otherwise kept while it works).
   void rebuildPreconditioner();
