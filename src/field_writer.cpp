@@ -152,7 +152,7 @@ struct FieldWriter::Impl {
     const hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
     if (fapl < 0 || (!alone() && H5Pset_fapl_mpio(fapl, comm, MPI_INFO_NULL) < 0)) {
       if (fapl >= 0) H5Pclose(fapl);
-      check(false, "cannot set up the MPI-IO file driver");
+      check(false, "cannot set up the file driver");
     }
     return fapl;
   }

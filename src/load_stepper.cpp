@@ -8,7 +8,8 @@
 namespace capstan {
 
 namespace {
-// The smallest sub-step, as a fraction of Time/Step Size: ten halvings.
+// The smallest sub-step, as a fraction of Time/Step Size (in steady rolling, of
+// the loads' ramp left at the step's start where that is shorter): ten halvings.
 constexpr double kMinimumSubstep = 1.0 / 1024;
 
 // How long after t the cores' external loads (forces, torques) still ramp: 0
