@@ -9,6 +9,7 @@
 #include <set>
 #include <string>
 
+#include "assembly.hpp"
 #include "mumps_solve_factory.hpp"
 
 namespace capstan {
@@ -66,7 +67,156 @@ BuildFromStratimikos pluginEntry() {
   return entry;
 }
 
+// A point per 3 owned unknowns, as MueLu groups them (number of equations 3),
+// for its repartitioning: the owned nodes' reference coordinates, then (rank
+// 0) two points per rigid core at its axis point, for its 6 unknowns.
+RCP<Tpetra::MultiVector<>> unknownCoordinates(const Assembly& assembly) {
+  const Mesh& mesh = assembly.mesh();
+  const size_t n = assembly.dofMap()->getNodeNumElements() / 3;
+  std::vector<GO> gids(n);
+  for (size_t k = 0; k < n; ++k) gids[k] = assembly.dofMap()->getGlobalElement(LO(3 * k)) / 3;
+  const auto invalid = Teuchos::OrdinalTraits<Tpetra::global_size_t>::invalid();
+  auto map = rcp(new Map(invalid, Teuchos::ArrayView<const GO>(gids), 0, mesh.comm));
+  auto coords = rcp(new Tpetra::MultiVector<>(map, 3));
+  for (size_t k = 0; k < mesh.numOwnedNodes; ++k)
+    for (int i = 0; i < 3; ++i) coords->replaceLocalValue(LO(k), i, mesh.X[3 * k + i]);
+  const auto& cores = assembly.rigidCores();
+  for (size_t k = mesh.numOwnedNodes; k < n; ++k) {
+    const auto& core = cores[(k - mesh.numOwnedNodes) / 2];
+    for (int i = 0; i < 3; ++i) coords->replaceLocalValue(LO(k), i, core.axisPoint[i]);
+  }
+  return coords;
+}
+
+// The six rigid-body modes of the body at its reference positions (about its
+// centroid): the near-null space that smoothed aggregation needs for
+// elasticity.
+RCP<Tpetra::MultiVector<>> rigidBodyModes(const Assembly& assembly) {
+  const Mesh& mesh = assembly.mesh();
+  auto modes = rcp(new Tpetra::MultiVector<>(assembly.dofMap(), 6));
+  double c[3] = {0, 0, 0}, local[4] = {0, 0, 0, double(mesh.numOwnedNodes)}, global[4];
+  for (size_t n = 0; n < mesh.numOwnedNodes; ++n)
+    for (int i = 0; i < 3; ++i) local[i] += mesh.X[3 * n + i];
+  Teuchos::reduceAll(*mesh.comm, Teuchos::REDUCE_SUM, 4, local, global);
+  for (int i = 0; i < 3; ++i) c[i] = global[i] / std::max(global[3], 1.0);
+  for (size_t n = 0; n < mesh.numOwnedNodes; ++n) {
+    const double x = mesh.X[3 * n] - c[0], y = mesh.X[3 * n + 1] - c[1], z = mesh.X[3 * n + 2] - c[2];
+    const LO d = LO(3 * n);
+    for (int i = 0; i < 3; ++i) modes->replaceLocalValue(d + i, i, 1.0);  // translations
+    // rotations about x, y, z: omega x r
+    modes->replaceLocalValue(d + 1, 3, -z), modes->replaceLocalValue(d + 2, 3, y);
+    modes->replaceLocalValue(d + 0, 4, z), modes->replaceLocalValue(d + 2, 4, -x);
+    modes->replaceLocalValue(d + 0, 5, -y), modes->replaceLocalValue(d + 1, 5, x);
+  }
+  // Rigid cores move with the body: translations move T; a rotation omega
+  // moves T by omega x (A - c) and turns the core by omega . d.
+  const auto& cores = assembly.rigidCores();
+  for (size_t k = 0; k < cores.size(); ++k) {
+    if (assembly.ownedCoreDof(k, 0) < 0) continue;
+    const LO d = assembly.ownedCoreDof(k, 0);
+    const auto& A = cores[k].axisPoint;
+    const auto& ax = cores[k].axisDirection;
+    const double x = A[0] - c[0], y = A[1] - c[1], z = A[2] - c[2];
+    for (int i = 0; i < 3; ++i) modes->replaceLocalValue(d + i, i, 1.0);
+    modes->replaceLocalValue(d + 1, 3, -z), modes->replaceLocalValue(d + 2, 3, y);
+    modes->replaceLocalValue(d + 0, 4, z), modes->replaceLocalValue(d + 2, 4, -x);
+    modes->replaceLocalValue(d + 0, 5, -y), modes->replaceLocalValue(d + 1, 5, x);
+    for (int m = 0; m < 3; ++m) modes->replaceLocalValue(d + 3, 3 + m, ax[m]);
+  }
+  return modes;
+}
+
 }  // namespace
+
+Teuchos::ParameterList stratimikosList(const SolverSettings& solver, const Assembly& assembly) {
+  const int ranks = assembly.dofMap()->getComm()->getSize();
+  Teuchos::ParameterList p("Stratimikos");
+  using S = SolverSettings;
+  const S::LinearSolver method = solver.linearSolver;
+  // Direct: MUMPS on any number of ranks (src/mumps_solve_factory.hpp).
+  // Amesos2's KLU2, still selectable through Solver/Stratimikos, solves our
+  // matrices wrongly on several ranks in Trilinos 13.2.
+  if (method == S::LinearSolver::Direct) {
+    p.set("Linear Solver Type", "MUMPS");
+    p.set("Preconditioner Type", "None");
+  } else {
+    p.set("Linear Solver Type", "Belos");
+    auto& belos = p.sublist("Linear Solver Types").sublist("Belos");
+    const std::string type = method == S::LinearSolver::CG ? "Pseudo Block CG" : "Block GMRES";
+    belos.set("Solver Type", type);
+    auto& st = belos.sublist("Solver Types").sublist(type);
+    st.set("Convergence Tolerance", solver.linearTolerance);
+    st.set("Maximum Iterations", solver.maxLinearIterations);
+    if (type == "Block GMRES") {
+      st.set("Num Blocks", 200);
+      st.set("Maximum Restarts", 20);
+    }
+    const S::Preconditioner prec = solver.preconditioner;
+    if (prec == S::Preconditioner::None) {
+      p.set("Preconditioner Type", "None");
+    } else if (prec == S::Preconditioner::LU) {
+      p.set("Preconditioner Type", "MUMPS");  // src/mumps_solve_factory.hpp
+    } else if (prec == S::Preconditioner::MueLu) {
+      // Smoothed aggregation with the rigid-body modes, Chebyshev smoothing.
+      p.set("Preconditioner Type", "MueLu");
+      auto& ml = p.sublist("Preconditioner Types").sublist("MueLu");
+      ml.set("verbosity", "none");
+      ml.set("number of equations", 3);
+      ml.set("multigrid algorithm", "sa");
+      // capstan's smoother, unless the scene picks another in
+      // Solver/Stratimikos/Preconditioner Types/MueLu/smoother: type (then
+      // that smoother's defaults: MueLu rejects a Chebyshev degree for it).
+      std::string userSmoother = "CHEBYSHEV";
+      const auto& strat = solver.stratimikos;
+      if (strat.isSublist("Preconditioner Types") && strat.sublist("Preconditioner Types").isSublist("MueLu")) {
+        const auto& user = strat.sublist("Preconditioner Types").sublist("MueLu");
+        if (user.isType<std::string>("smoother: type")) userSmoother = user.get<std::string>("smoother: type");
+      }
+      if (userSmoother == "CHEBYSHEV" && solver.gradedRings) {
+        // Graded rings (an annulus): symmetric Gauss-Seidel, two sweeps, and
+        // weak connections dropped. The Hertz ring: 654 Krylov iterations
+        // against 2,746 with Chebyshev, 2.6-2.8x faster (docs/performance.md).
+        ml.set("smoother: type", "RELAXATION");
+        ml.sublist("smoother: params").set("relaxation: type", "Symmetric Gauss-Seidel");
+        ml.sublist("smoother: params").set("relaxation: sweeps", 2);
+        ml.set("aggregation: drop tol", 0.05);
+      } else if (userSmoother == "CHEBYSHEV") {
+        ml.set("smoother: type", "CHEBYSHEV");
+        ml.sublist("smoother: params").set("chebyshev: degree", 2);
+      }
+      ml.set("coarse: max size", 1500);
+      // Restriction applied as P^T instead of a stored R: the same iterations
+      // and time, 5% less memory (docs/performance.md, "Defaults and why").
+      ml.set("transpose: use implicit", true);
+      ml.set("Nullspace", rigidBodyModes(assembly));
+      // On several ranks the coarse levels (below 2000 unknowns per rank) move
+      // onto one rank, so that the coarsest solve is a serial KLU2: Amesos2's
+      // KLU2 on a distributed matrix solves wrongly in Trilinos 13.2, and a
+      // wrong coarse solve doubles MueLu's iterations (docs/performance.md).
+      if (ranks > 1) {
+        ml.set("repartition: enable", true);
+        ml.set("repartition: partitioner", "zoltan2");
+        ml.set("repartition: start level", 1);
+        ml.set("repartition: min rows per proc", 2000);
+        ml.set("Coordinates", unknownCoordinates(assembly));
+      }
+    } else {
+      p.set("Preconditioner Type", "Ifpack2");
+      auto& ifp = p.sublist("Preconditioner Types").sublist("Ifpack2");
+      if (prec == S::Preconditioner::ILU) {
+        // ILU(k) of each rank's diagonal block (Ifpack2 filters out the
+        // off-rank columns itself): block Jacobi between ranks.
+        ifp.set("Prec Type", "RILUK");
+        ifp.sublist("Ifpack2 Settings").set("fact: iluk level-of-fill", solver.iluLevel);
+      } else {
+        ifp.set("Prec Type", "RELAXATION");
+        ifp.sublist("Ifpack2 Settings").set("relaxation: type", "Jacobi");
+      }
+    }
+  }
+  p.setParameters(solver.stratimikos);
+  return p;
+}
 
 bool builtWithoutStratimikos(const ParameterList& p) {
   static const std::set<std::string> known = {"Linear Solver Type", "Preconditioner Type", "Linear Solver Types",

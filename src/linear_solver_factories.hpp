@@ -1,5 +1,5 @@
-// The Thyra factories that solve capstan's linear systems, built from a
-// Stratimikos parameter list (src/newton.cpp writes it from Solver/...).
+// Which linear solver: capstan's Solver settings as a Stratimikos parameter
+// list, and the Thyra factories that solve with it.
 //
 // Why two paths: Stratimikos' builder, Ifpack2 and MueLu pull about 40 more
 // shared libraries into the process (Teko, ML, Epetra, AztecOO, Zoltan2, ...),
@@ -20,6 +20,14 @@
 #include <stdexcept>
 
 namespace capstan {
+
+class Assembly;
+struct SolverSettings;
+
+// capstan's solver knobs (Auto resolved) as a Stratimikos list, the scene's
+// Solver/Stratimikos sublist applied over them; MueLu's gets the body's
+// rigid-body modes (and on several ranks the unknowns' coordinates).
+Teuchos::ParameterList stratimikosList(const SolverSettings& solver, const Assembly& assembly);
 
 struct LinearSolverFactories {
   Teuchos::RCP<Thyra::LinearOpWithSolveFactoryBase<double>> lows;  // "Linear Solver Type"
