@@ -3,14 +3,13 @@
 #include <Teuchos_AbstractFactoryStd.hpp>
 #include <Thyra_BelosLinearOpWithSolveFactory.hpp>
 #include <dlfcn.h>
-#include <unistd.h>
 
-#include <climits>
 #include <set>
 #include <string>
 
 #include "assembly.hpp"
 #include "mumps_solve_factory.hpp"
+#include "program_directory.hpp"
 
 namespace capstan {
 
@@ -40,19 +39,12 @@ RCP<ParameterList> copyOf(const ParameterList& list, const std::string& kind, co
 
 // The plugin beside the running program, else where the build put it.
 void* openPlugin() {
-  const char* file = "libcapstan_krylov.so";
-  char self[PATH_MAX];
-  const ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
-  std::string tried;
-  if (n > 0) {
-    std::string path(self, size_t(n));
-    path = path.substr(0, path.rfind('/') + 1) + file;
-    if (void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL)) return handle;
-    tried = path + " (" + dlerror() + ")";
-  }
+  const std::string beside = programDirectory() + "libcapstan_krylov.so";
+  if (void* handle = dlopen(beside.c_str(), RTLD_NOW | RTLD_LOCAL)) return handle;
+  std::string tried = beside + " (" + dlerror() + ")";
 #ifdef CAPSTAN_KRYLOV_PLUGIN
   if (void* handle = dlopen(CAPSTAN_KRYLOV_PLUGIN, RTLD_NOW | RTLD_LOCAL)) return handle;
-  tried += std::string(tried.empty() ? "" : ", ") + CAPSTAN_KRYLOV_PLUGIN + " (" + dlerror() + ")";
+  tried += std::string(", ") + CAPSTAN_KRYLOV_PLUGIN + " (" + dlerror() + ")";
 #endif
   throw PluginError("cannot load capstan's Krylov solver plugin, needed for this scene's linear solver: tried " +
                     tried);
