@@ -31,8 +31,10 @@ constexpr double kStartSlipScales[] = {0.02, 0.004};
 // solve, GMRES with a kept LU, 1,087 Krylov iterations against 184).
 constexpr int kGuessPasses = 1;
 // Where the steady state after the Tanh stages fails, it is solved again from
-// their answer with Coulomb's stick this much softer (eps_t, its tangential
-// penalty), then 3x that. The drive at mu = 1.1-2 failed (the Newton solve
+// their answer with Coulomb's stick (eps_t, its tangential penalty) this much
+// softer than the automatic one, then 3x that: softer than the default, and
+// stiffer than a scene's much softer stick (eps_t = 1, 300x the automatic on
+// the drive, did not converge in 50 passes at any load). The drive at mu = 1.1-2 failed (the Newton solve
 // stagnated at |R| ~1e-2, and so did friction at the held angular velocity);
 // through the retries mu = 1.1, 1.2, 1.3, 1.5 and 2 converge in 125, 134, 91,
 // 71 and 82 Newton iterations (10x alone left 1.2 failing; retries from the
@@ -63,7 +65,7 @@ bool SteadyRolling::startFromRest(double t, StepRecord& rec, std::string& failur
   if (!coulomb.empty()) {
     const auto footprint = m_.snapshot();
     std::string why;
-    if (startThroughTanh(t, coulomb, rec, why) && steadyStateWithSofterSticks(t, coulomb, rec, why)) return true;
+    if (startThroughTanh(t, coulomb, rec, why) && steadyStateWithStickRetries(t, coulomb, rec, why)) return true;
     // Back to the footprint, for the start through friction at the held angular velocity.
     if (log_.on("newton"))
       log_.event("newton", format("steady rolling: the start through Tanh failed (%s): from the footprint again",
@@ -77,20 +79,25 @@ bool SteadyRolling::startFromRest(double t, StepRecord& rec, std::string& failur
   return solveStage(t, "steady state", rec, failure);
 }
 
-bool SteadyRolling::steadyStateWithSofterSticks(double t, const std::vector<SteadyFrictionEffect*>& coulomb,
+bool SteadyRolling::steadyStateWithStickRetries(double t, const std::vector<SteadyFrictionEffect*>& coulomb,
                                                 StepRecord& rec, std::string& failure) {
   const auto afterTanh = m_.snapshot();
-  for (double softening : {1.0, kRetryStickSoftening, 3 * kRetryStickSoftening}) {
-    for (auto* f : coulomb) f->softenStick(softening);
+  // 0: the scene's stick; then kRetryStickSoftening and 3x that times the
+  // automatic one (softer than the automatic stick, and stiffer than a
+  // scene's much softer one).
+  for (double stick : {0.0, kRetryStickSoftening, 3 * kRetryStickSoftening}) {
+    for (auto* f : coulomb) f->setStick(stick);
     bool ok = solveStage(t, "steady state", rec, failure);
-    for (auto* f : coulomb) f->softenStick(1.0);
-    // The softer stick's answer is the scene's too (the multipliers make the
-    // stick exact either way); the scene's eps_t from there.
-    if (ok && softening != 1.0) ok = solveStage(t, "steady state, the scene's stick", rec, failure);
+    for (auto* f : coulomb) f->setStick(0.0);
+    // The retry's answer is the scene's too (the multipliers make the stick
+    // exact either way); the scene's eps_t from there.
+    if (ok && stick != 0.0) ok = solveStage(t, "steady state, the scene's stick", rec, failure);
     if (ok) return true;
     if (log_.on("newton"))
-      log_.event("newton", format("steady rolling: the steady state with the stick %gx softer failed (%s)", softening,
-                                  failure.c_str()),
+      log_.event("newton",
+                 stick == 0.0 ? format("steady rolling: the steady state failed (%s)", failure.c_str())
+                              : format("steady rolling: the steady state with the stick %g x the automatic one failed (%s)",
+                                       stick, failure.c_str()),
                  json::Object().add("event", json::string("steady state failed")));
     m_.restore(afterTanh);
   }

@@ -41,10 +41,10 @@ class SteadyRolling {
   bool startThroughTanh(double t, const std::vector<SteadyFrictionEffect*>& coulomb, StepRecord& rec,
                         std::string& failure);
   // Coulomb's steady state from the Tanh stages' answer, with the scene's
-  // stick and, where that fails, kRetryStickSoftening x and 3x softer ones
-  // (then the scene's stick from their answer). False, with u and the
+  // stick and, where that fails, sticks kRetryStickSoftening x and 3x the
+  // automatic one (then the scene's stick from their answer). False, with u and the
   // multipliers at the Tanh answer, if all three fail.
-  bool steadyStateWithSofterSticks(double t, const std::vector<SteadyFrictionEffect*>& coulomb, StepRecord& rec,
+  bool steadyStateWithStickRetries(double t, const std::vector<SteadyFrictionEffect*>& coulomb, StepRecord& rec,
                                    std::string& failure);
   // passLimit > 0: a starting guess, that many augmentation passes.
   bool solveStage(double t, const char* what, StepRecord& rec, std::string& failure, int passLimit = 0);

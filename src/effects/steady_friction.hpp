@@ -56,9 +56,12 @@ class SteadyFrictionEffect : public FrictionEffect {
   // are left as they are).
   void useTanh(double speedFraction);
   void useCoulomb(bool seed);
-  // Coulomb's tangential penalty eps_t at `factor` x the scene's (the stick's
-  // slope, not where it ends: the multipliers make it exact either way).
-  void softenStick(double factor) { parameters_.tangentPenalty = factor * sceneTangentPenalty_; }
+  // Coulomb's tangential penalty eps_t (the stick's slope, not where it ends:
+  // the multipliers make it exact either way): `factor` x the automatic value
+  // (the contact's solve penalty), or the scene's with factor 0.
+  void setStick(double factor) {
+    parameters_.tangentPenalty = factor > 0 ? factor * contact_.solvePenalty() : sceneTangentPenalty_;
+  }
   // The flow's angular velocity scale: the no-slip estimate about +z.
   double referenceAngularVelocity() const { return omegaRef_; }
 

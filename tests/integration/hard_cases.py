@@ -20,6 +20,9 @@ first order).
     Coulomb's stick 30x softer: SteadyRolling::startFromRest), against the same scene
     with a tangential penalty of 3.4e-2 set in the scene, which converges directly; the
     speed ratios within 2e-5 too;
+  * the steady 3D drive with a very soft stick (Tangential Penalty = 1, 300x the automatic
+    value): the augmentation loop does not converge with it, the retry with a stick 10x the
+    automatic one does and the scene's stick holds from there; against the shipped scene;
   * the steady 3D drive pressed 8x harder (32 N, ramped in 1e-6 s of its one 1e-3 s step): the
     start from rest fails at the full force, and the step's cuts go to the loads (half the
     force first, LoadStepper::advance), against the force ramped over two steps.
@@ -37,6 +40,7 @@ FINE_H = ["Time/Steps=16", "Time/Step Size=0.005"]
 MU12 = "Capstans/capstan/Friction/Coefficient=1.2"
 NOFIELDS = "Output/Write Fields=false"
 F8 = "Supports/core/Force={0, -32, 0}"
+EPST1 = "Capstans/capstan/Friction/Tangential Penalty=1"
 
 # name, scene, settings, reference settings, max penetration, Newton budget
 CASES = [
@@ -63,6 +67,7 @@ CASES = [
     ("G1 in one step", "seed/g1.xml", ["Time/Steps=1", "Time/Step Size=5"], [], 5e-5, 300),
     ("steady drive mu = 1.2", "pinch-roller-steady.xml", [MU12, NOFIELDS], [MU12, NOFIELDS,
      "Capstans/capstan/Friction/Tangential Penalty=3.4e-2"], 5e-5, 300),
+    ("steady drive eps_t = 1", "pinch-roller-steady.xml", [EPST1, NOFIELDS], [NOFIELDS], 5e-5, 300),
     ("steady drive 8x force", "pinch-roller-steady.xml", [F8, NOFIELDS], [F8, NOFIELDS, "Time/Steps=2",
      "Supports/core/Force Ramp Time=0.002"], 5e-5, 1500),
 ]
