@@ -4,6 +4,7 @@
 #include <Teuchos_DefaultMpiComm.hpp>
 #include <dmumps_c.h>
 #include <metis.h>
+#include <smumps_c.h>
 #include <mpi.h>
 
 #include <algorithm>
@@ -15,9 +16,16 @@ namespace capstan {
 
 namespace {
 
-// MUMPS' 1-based ICNTL / INFOG numbering, as in its manual.
-inline MUMPS_INT& ICNTL(DMUMPS_STRUC_C& id, int i) { return id.icntl[i - 1]; }
-inline MUMPS_INT INFOG(const DMUMPS_STRUC_C& id, int i) { return id.infog[i - 1]; }
+// MUMPS' 1-based ICNTL / INFOG numbering, as in its manual; Id is the double
+// (DMUMPS_STRUC_C) or the single precision (SMUMPS_STRUC_C) instance.
+template <class Id>
+MUMPS_INT& ICNTL(Id& id, int i) { return id.icntl[i - 1]; }
+template <class Id>
+MUMPS_INT INFOG(const Id& id, int i) { return id.infog[i - 1]; }
+inline void mumps(DMUMPS_STRUC_C& id) { dmumps_c(&id); }
+inline void mumps(SMUMPS_STRUC_C& id) { smumps_c(&id); }
+inline MPI_Datatype mpiReal(const DMUMPS_STRUC_C&) { return MPI_DOUBLE; }
+inline MPI_Datatype mpiReal(const SMUMPS_STRUC_C&) { return MPI_FLOAT; }
 
 const char* explainInfog1(int e) {
   switch (e) {
@@ -46,7 +54,27 @@ bool anyRank(bool local, MPI_Comm comm) {
 }  // namespace
 
 struct MumpsSolver::Impl {
-  DMUMPS_STRUC_C id{};
+  // One MUMPS instance, in double or in single precision (MumpsOptions::
+  // precision); with(f) calls f on the one in use.
+  DMUMPS_STRUC_C d{};
+  SMUMPS_STRUC_C s{};
+  bool single = false;
+  template <class F>
+  decltype(auto) with(F&& f) { return single ? f(s) : f(d); }
+  template <class F>
+  decltype(auto) with(F&& f) const { return single ? f(s) : f(d); }
+  // Single precision: the values and right-hand sides MUMPS reads, as floats.
+  std::vector<float> aSingle, rhsSingle;
+  // Points `a` (centralised input) or `a_loc` at the values to factor, in
+  // the instance's precision.
+  void setValues(std::vector<double>& values, bool centralisedInput) {
+    if (single) {
+      aSingle.assign(values.begin(), values.end());
+      (centralisedInput ? s.a : s.a_loc) = aSingle.data();
+    } else {
+      (centralisedInput ? d.a : d.a_loc) = values.data();
+    }
+  }
   MPI_Comm comm = MPI_COMM_NULL;  // the user's communicator (not owned)
   int rank = 0, size = 1;
   // Host only (MumpsOptions::hostOnlyBelow): MUMPS runs on rank 0 alone, on
@@ -95,10 +123,7 @@ MumpsSolver::~MumpsSolver() {
   int finalized = 0;
   MPI_Finalized(&finalized);
   if (finalized) return;  // too late to free MUMPS' memory collectively
-  if (impl_->runsMumps()) {
-    impl_->id.job = -2;
-    dmumps_c(&impl_->id);
-  }
+  if (impl_->runsMumps()) impl_->with([](auto& id) { id.job = -2, mumps(id); });
   if (impl_->hostComm != MPI_COMM_NULL) MPI_Comm_free(&impl_->hostComm);
 }
 
@@ -111,33 +136,38 @@ void MumpsSolver::initialize(const Teuchos::Comm<int>& comm, bool hostOnly) {
   MPI_Comm_rank(impl->comm, &impl->rank);
   MPI_Comm_size(impl->comm, &impl->size);
   impl->hostOnly = hostOnly && impl->size > 1;
+  impl->single = options_.precision == MumpsOptions::Precision::Single;
   if (impl->hostOnly) MPI_Comm_split(impl->comm, impl->rank == 0 ? 0 : MPI_UNDEFINED, 0, &impl->hostComm);
-  DMUMPS_STRUC_C& id = impl->id;
-  id.comm_fortran = static_cast<MUMPS_INT>(MPI_Comm_c2f(impl->hostOnly ? impl->hostComm : impl->comm));  // MUMPS is Fortran inside
-  id.par = 1;  // the host (rank 0) works too
-  id.sym = 0;  // unsymmetric: friction
+  const auto fortranComm = static_cast<MUMPS_INT>(MPI_Comm_c2f(impl->hostOnly ? impl->hostComm : impl->comm));
+  impl->with([&](auto& id) {
+    id.comm_fortran = fortranComm;  // MUMPS is Fortran inside
+    id.par = 1;  // the host (rank 0) works too
+    id.sym = 0;  // unsymmetric: friction
+  });
   impl_ = std::move(impl);  // from here on the destructor frees what there is
   run(-1);
-  if (INFOG(id, 1) < 0) {
-    const int e = INFOG(id, 1);
+  if (const int e = impl_->with([](auto& id) { return INFOG(id, 1); }); e < 0) {
     if (impl_->hostComm != MPI_COMM_NULL) MPI_Comm_free(&impl_->hostComm);
     impl_.reset();  // no instance to free
     throw std::runtime_error("MUMPS initialisation failed: INFOG(1) = " + std::to_string(e));
   }
 
-  if (options_.verbose) {
-    ICNTL(id, 1) = 6, ICNTL(id, 2) = 0, ICNTL(id, 3) = 6, ICNTL(id, 4) = 2;
-  } else {
-    ICNTL(id, 1) = -1, ICNTL(id, 2) = -1, ICNTL(id, 3) = -1, ICNTL(id, 4) = 0;
-  }
-  // Distributed assembled matrix, pattern at analysis, values at
-  // factorisation; host only: the whole matrix on the host.
-  ICNTL(id, 18) = impl_->centralised() ? 0 : 3;
-  ICNTL(id, 20) = 0;  // dense right-hand sides on the host
-  ICNTL(id, 21) = 0;  // centralised solution (overwrites the right-hand sides)
-  ICNTL(id, 8) = options_.scaling ? 77 : 0;
-  ICNTL(id, 28) = 1;  // sequential analysis: Debian's build has neither ParMETIS nor PT-SCOTCH
-  if (options_.workspaceIncreasePercent >= 0) ICNTL(id, 14) = options_.workspaceIncreasePercent;
+  const bool centralised = impl_->centralised();
+  impl_->with([&](auto& id) {
+    if (options_.verbose) {
+      ICNTL(id, 1) = 6, ICNTL(id, 2) = 0, ICNTL(id, 3) = 6, ICNTL(id, 4) = 2;
+    } else {
+      ICNTL(id, 1) = -1, ICNTL(id, 2) = -1, ICNTL(id, 3) = -1, ICNTL(id, 4) = 0;
+    }
+    // Distributed assembled matrix, pattern at analysis, values at
+    // factorisation; on one rank or host only: the whole matrix on the host.
+    ICNTL(id, 18) = centralised ? 0 : 3;
+    ICNTL(id, 20) = 0;  // dense right-hand sides on the host
+    ICNTL(id, 21) = 0;  // centralised solution (overwrites the right-hand sides)
+    ICNTL(id, 8) = options_.scaling ? 77 : 0;
+    ICNTL(id, 28) = 1;  // sequential analysis: Debian's build has neither ParMETIS nor PT-SCOTCH
+    if (options_.workspaceIncreasePercent >= 0) ICNTL(id, 14) = options_.workspaceIncreasePercent;
+  });
 }
 
 bool MumpsSolver::extractPattern(const CrsMatrix& A) {
@@ -270,8 +300,7 @@ void MumpsSolver::analyse(const CrsMatrix& A) {
       if (m.keep[k0 + k]) m.irn[kept] = m.offsets[m.rank] + r + 1, m.jcn[kept] = colIndex[inds(k)], ++kept;
   }
 
-  DMUMPS_STRUC_C& id = m.id;
-  id.n = m.nGlobal;
+  m.with([&](auto& id) { id.n = m.nGlobal; });
   if (m.hostOnly) {
     const int mine = static_cast<int>(nnz);
     m.nnzCounts.assign(m.size, 0);
@@ -284,19 +313,25 @@ void MumpsSolver::analyse(const CrsMatrix& A) {
                 m.comm);
     MPI_Gatherv(m.jcn.data(), mine, MPI_INT, m.jcnAll.data(), m.nnzCounts.data(), m.nnzOffsets.data(), MPI_INT, 0,
                 m.comm);
-    id.nnz = static_cast<MUMPS_INT8>(all);
-    id.irn = m.irnAll.data();
-    id.jcn = m.jcnAll.data();
+    m.with([&](auto& id) {
+      id.nnz = static_cast<MUMPS_INT8>(all);
+      id.irn = m.irnAll.data();
+      id.jcn = m.jcnAll.data();
+    });
   } else if (m.size == 1) {
-    id.nnz = static_cast<MUMPS_INT8>(nnz);
-    id.irn = m.irn.data();
-    id.jcn = m.jcn.data();
-    id.a = m.a.data();
+    m.with([&](auto& id) {
+      id.nnz = static_cast<MUMPS_INT8>(nnz);
+      id.irn = m.irn.data();
+      id.jcn = m.jcn.data();
+    });
+    m.setValues(m.a, true);
   } else {
-    id.nnz_loc = static_cast<MUMPS_INT8>(nnz);
-    id.irn_loc = m.irn.data();
-    id.jcn_loc = m.jcn.data();
-    id.a_loc = m.a.data();
+    m.with([&](auto& id) {
+      id.nnz_loc = static_cast<MUMPS_INT8>(nnz);
+      id.irn_loc = m.irn.data();
+      id.jcn_loc = m.jcn.data();
+    });
+    m.setValues(m.a, false);
   }
   if (options_.ordering == MumpsOptions::Ordering::Auto) {
     double entries = double(nnz);
@@ -328,23 +363,25 @@ void MumpsSolver::analyse(const CrsMatrix& A) {
 double MumpsSolver::analyseWith(MumpsOptions::Ordering ordering) {
   Impl& m = *impl_;
   ++numOrderingAnalyses_;
-  DMUMPS_STRUC_C& id = m.id;
-  id.perm_in = nullptr;
+  int icntl7 = 0;
   switch (ordering) {
     case MumpsOptions::Ordering::Auto:  // analyse() resolves Auto before it gets here
       throw std::logic_error("MumpsSolver::analyseWith: Auto is not an ordering of its own");
     case MumpsOptions::Ordering::Metis:
       computeMetisOrdering();  // collective
-      ICNTL(id, 7) = 1;
-      id.perm_in = m.permIn.data();
+      icntl7 = 1;
       break;
-    case MumpsOptions::Ordering::Pord: ICNTL(id, 7) = 4; break;
-    case MumpsOptions::Ordering::Amd: ICNTL(id, 7) = 0; break;
-    case MumpsOptions::Ordering::Amf: ICNTL(id, 7) = 2; break;
-    case MumpsOptions::Ordering::Qamd: ICNTL(id, 7) = 6; break;
+    case MumpsOptions::Ordering::Pord: icntl7 = 4; break;
+    case MumpsOptions::Ordering::Amd: icntl7 = 0; break;
+    case MumpsOptions::Ordering::Amf: icntl7 = 2; break;
+    case MumpsOptions::Ordering::Qamd: icntl7 = 6; break;
   }
+  m.with([&](auto& id) {
+    ICNTL(id, 7) = icntl7;
+    id.perm_in = icntl7 == 1 ? m.permIn.data() : nullptr;
+  });
   call(1, "analysis");
-  return id.rinfog[0];  // the factorisation's estimated flops (broadcast by run())
+  return estimatedFlops();  // the factorisation's estimated flops (broadcast by run())
 }
 
 // METIS_NodeND on the graph of A + A^T (no diagonal), on rank 0 from the
@@ -406,21 +443,19 @@ void MumpsSolver::computeMetisOrdering() {
 
 void MumpsSolver::runFactorization() {
   Impl& m = *impl_;
-  DMUMPS_STRUC_C& id = m.id;
   const double t0 = MPI_Wtime();
   if (m.hostOnly) {
     MPI_Gatherv(m.a.data(), static_cast<int>(m.a.size()), MPI_DOUBLE, m.aAll.data(), m.nnzCounts.data(),
                 m.nnzOffsets.data(), MPI_DOUBLE, 0, m.comm);
-    id.a = m.aAll.data();
-  } else if (m.size == 1) {
-    id.a = m.a.data();
+    if (m.runsMumps()) m.setValues(m.aAll, true);
   } else {
-    id.a_loc = m.a.data();
+    m.setValues(m.a, m.size == 1);
   }
   run(2);
-  if (INFOG(id, 1) == -8 || INFOG(id, 1) == -9) {
+  const int e = m.with([](auto& id) { return INFOG(id, 1); });
+  if (e == -8 || e == -9) {
     // The analysis' estimate was short (delayed pivots): more room, once.
-    ICNTL(id, 14) = std::max(2 * ICNTL(id, 14), ICNTL(id, 14) + 50);
+    m.with([](auto& id) { ICNTL(id, 14) = std::max(2 * ICNTL(id, 14), ICNTL(id, 14) + 50); });
     ++numWorkspaceRetries_;
     run(2);
   }
@@ -432,12 +467,11 @@ void MumpsSolver::runFactorization() {
 
 // Runs JOB = job (0: only checks the last call's result) and throws on error.
 void MumpsSolver::call(int job, const char* phase) {
-  DMUMPS_STRUC_C& id = impl_->id;
   if (job != 0) run(job);
-  const int e = INFOG(id, 1);
+  const auto [e, e2] = impl_->with([](auto& id) { return std::pair(INFOG(id, 1), INFOG(id, 2)); });
   if (e < 0)
     throw std::runtime_error(std::string("MUMPS ") + phase + " failed: INFOG(1) = " + std::to_string(e) +
-                             ", INFOG(2) = " + std::to_string(INFOG(id, 2)) + explainInfog1(e));
+                             ", INFOG(2) = " + std::to_string(e2) + explainInfog1(e));
 }
 
 void MumpsSolver::solve(const MultiVector& b, MultiVector& x) {
@@ -458,11 +492,15 @@ void MumpsSolver::solve(const MultiVector& b, MultiVector& x) {
     MPI_Gatherv(bj.getRawPtr(), m.nLocal, MPI_DOUBLE, m.rank == 0 ? m.rhs.data() + j * n : nullptr,
                 m.counts.data(), m.offsets.data(), MPI_DOUBLE, 0, m.comm);
   }
-  DMUMPS_STRUC_C& id = m.id;
-  id.nrhs = static_cast<MUMPS_INT>(nrhs);
-  id.lrhs = m.nGlobal;
-  id.rhs = m.rank == 0 ? m.rhs.data() : nullptr;
+  if (m.single && m.rank == 0) m.rhsSingle.assign(m.rhs.begin(), m.rhs.end());
+  m.with([&](auto& id) {
+    id.nrhs = static_cast<MUMPS_INT>(nrhs);
+    id.lrhs = m.nGlobal;
+  });
+  m.d.rhs = m.rank == 0 ? m.rhs.data() : nullptr;
+  m.s.rhs = m.rank == 0 ? m.rhsSingle.data() : nullptr;
   call(3, "solve");
+  if (m.single && m.rank == 0) std::copy(m.rhsSingle.begin(), m.rhsSingle.end(), m.rhs.begin());
   for (std::size_t j = 0; j < nrhs; ++j) {
     auto xj = x.getDataNonConst(j);
     MPI_Scatterv(m.rank == 0 ? m.rhs.data() + j * n : nullptr, m.counts.data(), m.offsets.data(), MPI_DOUBLE,
@@ -473,23 +511,27 @@ void MumpsSolver::solve(const MultiVector& b, MultiVector& x) {
 
 void MumpsSolver::run(int job) {
   Impl& m = *impl_;
-  if (m.runsMumps()) {
-    m.id.job = job;
-    dmumps_c(&m.id);
-  }
-  // Host only: the other ranks learn the outcome (and the figures) from rank 0.
-  if (m.hostOnly) MPI_Bcast(m.id.infog, 80, MPI_INT, 0, m.comm), MPI_Bcast(m.id.rinfog, 40, MPI_DOUBLE, 0, m.comm);
+  m.with([&](auto& id) {
+    if (m.runsMumps()) id.job = job, mumps(id);
+    // Host only: the other ranks learn the outcome (and the figures) from rank 0.
+    if (m.hostOnly) MPI_Bcast(id.infog, 80, MPI_INT, 0, m.comm), MPI_Bcast(id.rinfog, 40, mpiReal(id), 0, m.comm);
+  });
 }
 
 std::int64_t MumpsSolver::factorEntries() const {
   if (!impl_) return 0;
-  const std::int64_t v = INFOG(impl_->id, 29);
+  const std::int64_t v = impl_->with([](auto& id) { return INFOG(id, 29); });
   return v < 0 ? -v * 1000000 : v;  // negative: millions of entries
 }
 
-int MumpsSolver::peakMemoryMB() const { return impl_ ? INFOG(impl_->id, 21) : 0; }
-int MumpsSolver::totalMemoryMB() const { return impl_ ? INFOG(impl_->id, 22) : 0; }
-int MumpsSolver::orderingUsed() const { return impl_ ? INFOG(impl_->id, 7) : -1; }
-double MumpsSolver::estimatedFlops() const { return impl_ ? impl_->id.rinfog[0] : 0.0; }
+int MumpsSolver::infog(int i) const {
+  return impl_ ? impl_->with([i](auto& id) { return INFOG(id, i); }) : 0;
+}
+int MumpsSolver::peakMemoryMB() const { return infog(21); }
+int MumpsSolver::totalMemoryMB() const { return infog(22); }
+int MumpsSolver::orderingUsed() const { return impl_ ? infog(7) : -1; }
+double MumpsSolver::estimatedFlops() const {
+  return impl_ ? impl_->with([](auto& id) { return double(id.rinfog[0]); }) : 0.0;
+}
 
 }  // namespace capstan

@@ -83,6 +83,12 @@ struct MumpsOptions {
   // zone settles) cost 3-24 ms each (docs/performance.md, "Linear solvers").
   // Off: the matrix graph's pattern, zeros and all.
   bool nonzeroPattern = true;
+  // The factorisation's arithmetic. Single (smumps): half the factors' memory
+  // and traffic, a factorisation accurate to about 1e-7 x the condition
+  // number: a preconditioner for GMRES, which restores double precision, not
+  // a solve of its own (the direct solve's factory refuses it).
+  enum class Precision { Double, Single };
+  Precision precision = Precision::Double;
 };
 
 class MumpsSolver {
@@ -90,7 +96,7 @@ class MumpsSolver {
   using Scalar = Tpetra::CrsMatrix<>::scalar_type;
   using CrsMatrix = Tpetra::CrsMatrix<>;
   using MultiVector = Tpetra::MultiVector<>;
-  static_assert(std::is_same<Scalar, double>::value, "MumpsSolver wraps dmumps (double)");
+  static_assert(std::is_same<Scalar, double>::value, "MumpsSolver takes double matrices (factored by dmumps or smumps)");
 
   explicit MumpsSolver(const MumpsOptions& options = MumpsOptions());
   ~MumpsSolver();
@@ -143,6 +149,7 @@ class MumpsSolver {
   double analyseWith(MumpsOptions::Ordering ordering);  // one analysis; returns its estimated flops
   void runFactorization();
   void call(int job, const char* phase);
+  int infog(int i) const;  // INFOG(i) of the last call, 0 before the first
 
   MumpsOptions options_;
   std::unique_ptr<Impl> impl_;

@@ -142,6 +142,9 @@ RCP<const Teuchos::ParameterList> validMumpsOptions() {
     valid->set("Host Only Below", 2000,
                "Matrices with fewer rows are factored on rank 0 alone, larger ones by every rank; 0: always every "
                "rank (src/direct_solver.hpp has the measurements)");
+    valid->set("Precision", std::string("Double"),
+               "Double | Single: the factorisation's arithmetic; Single (half the memory) only as GMRES' "
+               "preconditioner (Solver/Preconditioner = LU), whose iterations restore double precision");
     valid->set("Nonzero Pattern", true,
                "MUMPS sees the entries nonzero so far (and the diagonal), the analysis redone when one more turns "
                "nonzero; false: the matrix graph's whole pattern");
@@ -161,11 +164,23 @@ void readMumpsOptions(Teuchos::ParameterList& list, MumpsShared& shared) {
   shared.options.verbose = list.get<bool>("Verbose");
   shared.options.scaling = list.get<bool>("Scaling");
   shared.options.nonzeroPattern = list.get<bool>("Nonzero Pattern");
+  const auto precision = list.get<std::string>("Precision");
+  if (precision != "Double" && precision != "Single")
+    throw std::invalid_argument("MUMPS: 'Precision' = '" + precision + "' is not Double or Single");
+  shared.options.precision = precision == "Single" ? MumpsOptions::Precision::Single : MumpsOptions::Precision::Double;
   const int hostOnlyBelow = list.get<int>("Host Only Below");
   if (hostOnlyBelow < 0) throw std::invalid_argument("MUMPS: 'Host Only Below' = " + std::to_string(hostOnlyBelow) + " is negative");
   shared.options.hostOnlyBelow = hostOnlyBelow;
   shared.solver.reset();
   shared.factoredFor = nullptr;
+}
+
+void MumpsSolveFactory::setParameterList(const RCP<Teuchos::ParameterList>& list) {
+  MumpsParameters::setParameterList(list);
+  if (shared_->options.precision == MumpsOptions::Precision::Single)
+    throw std::invalid_argument(
+        "MUMPS: 'Precision' = 'Single' is for the LU preconditioner (Solver/Preconditioner = LU); a direct solve "
+        "factorises in Double");
 }
 
 bool MumpsSolveFactory::isCompatible(const Thyra::LinearOpSourceBase<double>& src) const {

@@ -52,6 +52,9 @@ class MumpsParameters : public Base {
 
 class MumpsSolveFactory : public MumpsParameters<Thyra::LinearOpWithSolveFactoryBase<double>> {
  public:
+  // As MumpsParameters', and Precision = Single is refused: a direct solve
+  // in single precision would give Newton directions to about 1e-7 only.
+  void setParameterList(const Teuchos::RCP<Teuchos::ParameterList>& list) override;
   bool isCompatible(const Thyra::LinearOpSourceBase<double>& fwdOpSrc) const override;
   Teuchos::RCP<Thyra::LinearOpWithSolveBase<double>> createOp() const override;
   void initializeOp(const Teuchos::RCP<const Thyra::LinearOpSourceBase<double>>& fwdOpSrc,

@@ -283,6 +283,77 @@ TEST(LinearSolverFactories, BuiltInListsMatchTheBuilderWithoutLoadingIt) {
   EXPECT_THROW(linearSolverFactories(bad), std::invalid_argument);
 }
 
+// Precision = Single: the factors in float (smumps). A solve is accurate to
+// float's precision only, on every rank count; GMRES with the factorisation as
+// its preconditioner restores double precision in a few more iterations; the
+// direct solve's factory refuses it.
+TEST(Mumps, SinglePrecisionSolvesToFloatAccuracyAndPreconditionsGmresToDouble) {
+  auto map = contiguousMap(N, worldComm());
+  auto A = convectionDiffusion(map, ConvDiff{});
+  MumpsOptions single = testOptions();
+  single.precision = MumpsOptions::Precision::Single;
+  MumpsSolver solver(single);
+  for (double velocity : {1.0, 0.5}) {  // a refactorisation with the same pattern too
+    auto Av = convectionDiffusion(map, ConvDiff{velocity});
+    solver.factor(*Av);
+    auto xTrue = knownSolution(map, 2);
+    MultiVector b(map, 2), x(map, 2);
+    Av->apply(*xTrue, b);
+    solver.solve(b, x);
+    x.update(-1.0, *xTrue, 1.0);
+    std::vector<double> en(2);
+    x.normInf(en);
+    for (int c = 0; c < 2; ++c) {
+      EXPECT_LT(en[c], 1e-5) << "column " << c;   // float: about 1e-7 x the condition number
+      EXPECT_GT(en[c], 1e-12) << "column " << c;  // and not double's accuracy
+    }
+  }
+  EXPECT_EQ(solver.numAnalyses(), 1);
+  EXPECT_EQ(solver.numFactorizations(), 2);
+
+  Teuchos::ParameterList gmres;
+  gmres.set("Linear Solver Type", "Belos");
+  gmres.set("Preconditioner Type", "MUMPS");
+  auto& belos = gmres.sublist("Linear Solver Types").sublist("Belos");
+  belos.set("Solver Type", "Block GMRES");
+  belos.sublist("Solver Types").sublist("Block GMRES").set("Convergence Tolerance", 1e-13);
+  auto op = Thyra::createConstLinearOp(Teuchos::rcp_implicit_cast<const Tpetra::Operator<>>(A));
+  auto space = Thyra::createVectorSpace<double>(map);
+  auto xTrue = knownSolution(map, 1);
+  auto b = rcp(new MultiVector(map, 1));
+  A->apply(*xTrue, *b);
+  auto gmresSolve = [&](const std::string& precision, int& iterations) {
+    auto list = gmres;
+    list.sublist("Preconditioner Types").sublist("MUMPS").set("Precision", precision);
+    auto f = capstan::linearSolverFactories(list);
+    auto prec = f.prec->createPrec();
+    f.prec->initializePrec(Thyra::defaultLinearOpSource<double>(op), prec.get());
+    auto lows = f.lows->createOp();
+    f.lows->initializePreconditionedOp(Thyra::defaultLinearOpSource<double>(op), prec, lows.get());
+    auto x = rcp(new MultiVector(map, 1));
+    auto xt = Thyra::createMultiVector(x, space);
+    const auto status = Thyra::solve<double>(*lows, Thyra::NOTRANS,
+                                             *Thyra::createConstMultiVector(RCP<const MultiVector>(b), space), xt.ptr());
+    EXPECT_EQ(status.solveStatus, Thyra::SOLVE_STATUS_CONVERGED);
+    iterations = status.extraParameters.is_null() ? 0 : status.extraParameters->get("Iteration Count", 0);
+    MultiVector e(*xTrue, Teuchos::Copy);
+    e.update(1.0, *Thyra::TpetraOperatorVectorExtraction<double>::getTpetraMultiVector(xt), -1.0);
+    std::vector<double> en(1);
+    e.normInf(en);
+    EXPECT_LT(en[0], 1e-11) << precision;
+  };
+  int doubleIts = 0, singleIts = 0;
+  gmresSolve("Double", doubleIts);
+  gmresSolve("Single", singleIts);
+  EXPECT_GT(singleIts, doubleIts);       // the float factors are not exact
+  EXPECT_LE(singleIts, doubleIts + 4);  // but nearly
+  Teuchos::ParameterList direct;
+  direct.set("Linear Solver Type", "MUMPS");
+  direct.set("Preconditioner Type", "None");
+  direct.sublist("Linear Solver Types").sublist("MUMPS").set("Precision", "Single");
+  EXPECT_THROW(capstan::linearSolverFactories(direct), std::invalid_argument);
+}
+
 TEST(Mumps, EveryOrderingSolves) {
   auto A = convectionDiffusion(contiguousMap(N, worldComm()), ConvDiff{});
   using O = MumpsOptions::Ordering;
