@@ -148,12 +148,11 @@ Teuchos::ParameterList stratimikosList(const SolverSettings& solver, const Assem
       p.set("Preconditioner Type", "None");
     } else if (prec == S::Preconditioner::LU) {
       p.set("Preconditioner Type", "MUMPS");  // src/mumps_solve_factory.hpp
-      // Factored in single precision on a box: G1 2x 2.24-2.34 s against
-      // 2.94-3.43 s, the same Newton iterations, the forces 3e-11 apart. Not on
-      // graded rings, whose matrices single precision cannot factor well
-      // enough: the Hertz ring's pressure step stalls, the steady drive needs
-      // 2.8x the GMRES iterations (docs/performance.md, "Defaults and why").
-      p.sublist("Preconditioner Types").sublist("MUMPS").set("Precision", solver.gradedRings ? "Double" : "Single");
+      // Factored in single precision (with flexible GMRES): G1 2x 1.97-2.19 s
+      // against 2.86-3.17 s, the 126k-dof steady drive on 2 ranks 100 s and
+      // 0.9 GB a rank against 135 s and 1.3 GB, the same Newton iterations
+      // and answers to 1e-8 (docs/performance.md, "Defaults and why").
+      p.sublist("Preconditioner Types").sublist("MUMPS").set("Precision", "Single");
     } else if (prec == S::Preconditioner::MueLu) {
       // Smoothed aggregation with the rigid-body modes, Chebyshev smoothing.
       p.set("Preconditioner Type", "MueLu");
