@@ -11,6 +11,7 @@
 #include <Tpetra_Core.hpp>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <cstdio>
@@ -127,6 +128,51 @@ RCP<MultiVector> solveAndCheck(MumpsSolver& solver, const CrsMatrix& A, int nrhs
   return x;
 }
 
+// GMRES (Block GMRES to 1e-13) preconditioned by a MUMPS factorisation, as
+// Stratimikos lists it.
+Teuchos::ParameterList gmresWithMumps() {
+  Teuchos::ParameterList gmres;
+  gmres.set("Linear Solver Type", "Belos");
+  gmres.set("Preconditioner Type", "MUMPS");
+  auto& belos = gmres.sublist("Linear Solver Types").sublist("Belos");
+  belos.set("Solver Type", "Block GMRES");
+  belos.sublist("Solver Types").sublist("Block GMRES").set("Convergence Tolerance", 1e-13);
+  return gmres;
+}
+
+// Solves A x = b through the factories (with their preconditioner, if any)
+// as NOX does; expects convergence and returns x and the Krylov iterations.
+RCP<MultiVector> solveThrough(const LinearSolverFactories& f, const RCP<const CrsMatrix>& A, const MultiVector& b,
+                              int& iterations) {
+  auto op = Thyra::createConstLinearOp(Teuchos::rcp_implicit_cast<const Tpetra::Operator<>>(A));
+  auto space = Thyra::createVectorSpace<double>(A->getRowMap());
+  RCP<Thyra::LinearOpWithSolveBase<double>> lows;
+  if (f.prec.is_null()) {
+    lows = Thyra::linearOpWithSolve<double>(*f.lows, op);
+  } else {
+    auto prec = f.prec->createPrec();
+    f.prec->initializePrec(Thyra::defaultLinearOpSource<double>(op), prec.get());
+    lows = f.lows->createOp();
+    f.lows->initializePreconditionedOp(Thyra::defaultLinearOpSource<double>(op), prec, lows.get());
+  }
+  auto x = rcp(new MultiVector(A->getRowMap(), b.getNumVectors()));
+  auto xt = Thyra::createMultiVector(x, space);
+  auto bt = Thyra::createConstMultiVector(Teuchos::rcpFromRef(b), space);
+  const auto status = Thyra::solve<double>(*lows, Thyra::NOTRANS, *bt, xt.ptr());
+  EXPECT_EQ(status.solveStatus, Thyra::SOLVE_STATUS_CONVERGED);
+  iterations = status.extraParameters.is_null() ? 0 : status.extraParameters->get("Iteration Count", 0);
+  return Thyra::TpetraOperatorVectorExtraction<double>::getTpetraMultiVector(xt);
+}
+
+// The largest error of x's columns against the known solution's.
+double errorAgainst(const MultiVector& xTrue, const MultiVector& x) {
+  MultiVector e(xTrue, Teuchos::Copy);
+  e.update(1.0, x, -1.0);
+  std::vector<double> en(x.getNumVectors());
+  e.normInf(en);
+  return *std::max_element(en.begin(), en.end());
+}
+
 }  // namespace
 
 TEST(Mumps, SolvesConvectionDiffusionWithThreeRightHandSides) {
@@ -205,16 +251,10 @@ TEST(MumpsThyra, OperatorsShareTheAnalysisAndSolveWithTheirOwnValues) {
 TEST(LinearSolverFactories, BuiltInListsMatchTheBuilderWithoutLoadingIt) {
   using capstan::builtWithoutStratimikos;
   using capstan::linearSolverFactories;
-  using Converter = Thyra::TpetraOperatorVectorExtraction<double>;
   Teuchos::ParameterList direct;
   direct.set("Linear Solver Type", "MUMPS");
   direct.set("Preconditioner Type", "None");
-  Teuchos::ParameterList gmres;
-  gmres.set("Linear Solver Type", "Belos");
-  gmres.set("Preconditioner Type", "MUMPS");
-  auto& belos = gmres.sublist("Linear Solver Types").sublist("Belos");
-  belos.set("Solver Type", "Block GMRES");
-  belos.sublist("Solver Types").sublist("Block GMRES").set("Convergence Tolerance", 1e-13);
+  Teuchos::ParameterList gmres = gmresWithMumps();
   gmres.sublist("Preconditioner Types").sublist("MUMPS").set("Ordering", "AMD");
   EXPECT_TRUE(builtWithoutStratimikos(direct));
   EXPECT_TRUE(builtWithoutStratimikos(gmres));
@@ -234,29 +274,10 @@ TEST(LinearSolverFactories, BuiltInListsMatchTheBuilderWithoutLoadingIt) {
   const bool builderLoadedBefore = dlopen("libtrilinos_stratimikos.so.13.2", RTLD_NOW | RTLD_NOLOAD) != nullptr;
   auto map = contiguousMap(N, worldComm());
   auto A = convectionDiffusion(map, ConvDiff{});
-  auto op = Thyra::createConstLinearOp(Teuchos::rcp_implicit_cast<const Tpetra::Operator<>>(A));
   auto xTrue = knownSolution(map, 1);
-  auto b = rcp(new MultiVector(map, 1));
-  A->apply(*xTrue, *b);
-  auto space = Thyra::createVectorSpace<double>(map);
-  auto solve = [&](const capstan::LinearSolverFactories& f, int& iterations) {
-    auto x = rcp(new MultiVector(map, 1));
-    RCP<Thyra::LinearOpWithSolveBase<double>> lows;
-    if (f.prec.is_null()) {
-      lows = Thyra::linearOpWithSolve<double>(*f.lows, op);
-    } else {
-      auto prec = f.prec->createPrec();
-      f.prec->initializePrec(Thyra::defaultLinearOpSource<double>(op), prec.get());
-      lows = f.lows->createOp();
-      f.lows->initializePreconditionedOp(Thyra::defaultLinearOpSource<double>(op), prec, lows.get());
-    }
-    auto xt = Thyra::createMultiVector(x, space);
-    const auto status = Thyra::solve<double>(*lows, Thyra::NOTRANS,
-                                             *Thyra::createConstMultiVector(RCP<const MultiVector>(b), space), xt.ptr());
-    EXPECT_EQ(status.solveStatus, Thyra::SOLVE_STATUS_CONVERGED);
-    iterations = status.extraParameters.is_null() ? 0 : status.extraParameters->get("Iteration Count", 0);
-    return Converter::getTpetraMultiVector(xt);
-  };
+  MultiVector b(map, 1);
+  A->apply(*xTrue, b);
+  auto solve = [&](const capstan::LinearSolverFactories& f, int& iterations) { return solveThrough(f, A, b, iterations); };
   int directIts = -1, gmresIts = -1, pluginIts = -1;
   auto xDirect = solve(linearSolverFactories(direct), directIts);
   auto xGmres = solve(linearSolverFactories(gmres), gmresIts);
@@ -270,13 +291,7 @@ TEST(LinearSolverFactories, BuiltInListsMatchTheBuilderWithoutLoadingIt) {
   auto xPlugin = solve(viaBuilder, pluginIts);
   EXPECT_EQ(gmresIts, pluginIts);
   EXPECT_GE(gmresIts, 1);
-  for (const auto& x : {xDirect, xGmres, xPlugin}) {
-    MultiVector e(*xTrue, Teuchos::Copy);
-    e.update(1.0, *x, -1.0);
-    std::vector<double> en(1);
-    e.normInf(en);
-    EXPECT_LT(en[0], 1e-10);
-  }
+  for (const auto& x : {xDirect, xGmres, xPlugin}) EXPECT_LT(errorAgainst(*xTrue, *x), 1e-10);
   // A bad value in a built-in list is still an error naming it.
   auto bad = gmres;
   bad.sublist("Preconditioner Types").sublist("MUMPS").set("Ordering", "Nested");
@@ -311,36 +326,14 @@ TEST(Mumps, SinglePrecisionSolvesToFloatAccuracyAndPreconditionsGmresToDouble) {
   EXPECT_EQ(solver.numAnalyses(), 1);
   EXPECT_EQ(solver.numFactorizations(), 2);
 
-  Teuchos::ParameterList gmres;
-  gmres.set("Linear Solver Type", "Belos");
-  gmres.set("Preconditioner Type", "MUMPS");
-  auto& belos = gmres.sublist("Linear Solver Types").sublist("Belos");
-  belos.set("Solver Type", "Block GMRES");
-  belos.sublist("Solver Types").sublist("Block GMRES").set("Convergence Tolerance", 1e-13);
-  auto op = Thyra::createConstLinearOp(Teuchos::rcp_implicit_cast<const Tpetra::Operator<>>(A));
-  auto space = Thyra::createVectorSpace<double>(map);
   auto xTrue = knownSolution(map, 1);
-  auto b = rcp(new MultiVector(map, 1));
-  A->apply(*xTrue, *b);
+  MultiVector b(map, 1);
+  A->apply(*xTrue, b);
   auto gmresSolve = [&](const std::string& precision, int& iterations) {
-    auto list = gmres;
+    auto list = gmresWithMumps();
     list.sublist("Preconditioner Types").sublist("MUMPS").set("Precision", precision);
-    auto f = capstan::linearSolverFactories(list);
-    auto prec = f.prec->createPrec();
-    f.prec->initializePrec(Thyra::defaultLinearOpSource<double>(op), prec.get());
-    auto lows = f.lows->createOp();
-    f.lows->initializePreconditionedOp(Thyra::defaultLinearOpSource<double>(op), prec, lows.get());
-    auto x = rcp(new MultiVector(map, 1));
-    auto xt = Thyra::createMultiVector(x, space);
-    const auto status = Thyra::solve<double>(*lows, Thyra::NOTRANS,
-                                             *Thyra::createConstMultiVector(RCP<const MultiVector>(b), space), xt.ptr());
-    EXPECT_EQ(status.solveStatus, Thyra::SOLVE_STATUS_CONVERGED);
-    iterations = status.extraParameters.is_null() ? 0 : status.extraParameters->get("Iteration Count", 0);
-    MultiVector e(*xTrue, Teuchos::Copy);
-    e.update(1.0, *Thyra::TpetraOperatorVectorExtraction<double>::getTpetraMultiVector(xt), -1.0);
-    std::vector<double> en(1);
-    e.normInf(en);
-    EXPECT_LT(en[0], 1e-11) << precision;
+    EXPECT_LT(errorAgainst(*xTrue, *solveThrough(capstan::linearSolverFactories(list), A, b, iterations)), 1e-11)
+        << precision;
   };
   int doubleIts = 0, singleIts = 0;
   gmresSolve("Double", doubleIts);
