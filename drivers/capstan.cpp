@@ -105,7 +105,9 @@ int main(int argc, char** argv) {
       const auto options = Teuchos::ParameterList::PrintOptions().showDoc(true).showTypes(true).indent(2);
       capstan::validParameters().print(std::cout, options);
       // Stratimikos' list is passed through; the MUMPS part of it is capstan's own.
-      std::cout << "\nSolver/Stratimikos/Linear Solver Types/MUMPS (Linear Solver = Direct, Preconditioner = LU):\n";
+      std::cout << "\nSolver/Stratimikos/Linear Solver Types/MUMPS (Linear Solver = Direct) and "
+                   "Solver/Stratimikos/Preconditioner Types/MUMPS (Preconditioner = LU; Precision: Single by "
+                   "default there):\n";
       capstan::validMumpsOptions()->print(std::cout, options);
     }
     return 0;
