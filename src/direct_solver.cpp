@@ -86,8 +86,9 @@ struct MumpsSolver::Impl {
   std::vector<double> aAll;
   std::vector<int> nnzCounts, nnzOffsets;  // entries per rank (host only)
   bool runsMumps() const { return !hostOnly || rank == 0; }
-  // The whole matrix handed over on one rank: MUMPS' distributed input
-  // redistributes its entries even on one rank (the 3D drive: ~12% of a run).
+  // The whole matrix handed over on one rank (centralised input): MUMPS'
+  // distributed input redistributes the entries even there; the steady 3D
+  // drive runs 4.5% faster (1.10 against 1.15 s, medians of 7 alternating runs).
   bool centralised() const { return hostOnly || size == 1; }
 
   // The pattern of the last analysis in global ids (this rank's rows), to tell

@@ -6,8 +6,11 @@
 // factorisation is repeated.
 //
 // Each rank hands MUMPS its own rows (distributed assembled input, ICNTL(18) = 3,
-// 1-based global indices); right-hand sides are gathered to rank 0 (MUMPS' host)
-// and the solution is scattered back. Unsymmetric mode (SYM = 0).
+// 1-based global indices; on one rank, or below MumpsOptions::hostOnlyBelow,
+// the whole matrix on rank 0); right-hand sides are gathered to rank 0 (MUMPS'
+// host) and the solution is scattered back. Unsymmetric mode (SYM = 0). The
+// factors are double (dmumps) or single precision (smumps, MumpsOptions::
+// precision: for the LU preconditioner).
 //
 // Every method is collective over the matrix's communicator, the destructor too
 // (MUMPS' JOB = -2): create and destroy a solver on every rank, before MPI is
