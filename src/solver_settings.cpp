@@ -169,9 +169,9 @@ SolverSettings SolverSettings::resolved(long dofs, bool annulus, bool friction, 
   s.gradedRings = gradedRings || annulus;  // NewtonSolver resolves again, knowing no mesh
   // Auto's direct size: 50,000 on an annulus; on a box 5,000, and 12,000 for
   // the monolithic loop (no friction), whose steps a factorisation serves
-  // better than MueLu's V-cycle: G1 2x (10,179 unknowns) 3.48 s with the LU
-  // preconditioner against 4.34 s with MueLu (5.02 s nested), G1 3x (31,863)
-  // 26.7 s against 17.5 s (docs/performance.md, "Defaults and why").
+  // better than MueLu's V-cycle: G1 2x (10,179 unknowns) 2.14 s with the LU
+  // preconditioner against 4.41 s with MueLu; G1 3x (31,863) 15.7 s against
+  // 16.1 s, with 1.6x the memory (docs/performance.md, "Defaults and why").
   const long most = s.directSolverMaxDofs > 0 ? s.directSolverMaxDofs
                     : annulus                  ? 50000
                     : s.monolithic && !friction ? 12000
