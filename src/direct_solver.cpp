@@ -89,7 +89,7 @@ struct MumpsSolver::Impl {
   bool runsMumps() const { return !hostOnly || rank == 0; }
   // The whole matrix handed over on one rank (centralised input): MUMPS'
   // distributed input redistributes the entries even there; the steady 3D
-  // drive runs 4.5% faster (1.10 against 1.15 s, medians of 7 alternating runs).
+  // drive runs 3.5% faster (1.13 against 1.17 s, medians of 7 alternating runs).
   bool centralised() const { return hostOnly || size == 1; }
 
   // The pattern of the last analysis in global ids (this rank's rows), to tell
