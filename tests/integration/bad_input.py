@@ -203,6 +203,18 @@ bad_value("Stratimikos: unknown solver", [('<ParameterList name="Output">',
                                            '<Parameter name="Linear Solver Type" type="string" value="Bogus"/>'
                                            '</ParameterList></ParameterList><ParameterList name="Output">')],
           "Solver/Stratimikos")
+# MUMPS' Precision: a word it does not know, and Single for a direct solve (float factors
+# would give Newton directions to about 1e-7 only).
+for label, solver, value in (("MUMPS: unknown precision", "GMRES", "Quad"),
+                             ("MUMPS: single-precision direct solve", "Direct", "Single")):
+    lists = "Preconditioner Types" if solver == "GMRES" else "Linear Solver Types"
+    bad_value(label, [('<ParameterList name="Output">',
+                       f'<ParameterList name="Solver"><Parameter name="Linear Solver" type="string" value="{solver}"/>'
+                       + ('<Parameter name="Preconditioner" type="string" value="LU"/>' if solver == "GMRES" else "")
+                       + f'<ParameterList name="Stratimikos"><ParameterList name="{lists}"><ParameterList name="MUMPS">'
+                       f'<Parameter name="Precision" type="string" value="{value}"/>'
+                       '</ParameterList></ParameterList></ParameterList></ParameterList><ParameterList name="Output">')],
+              "Precision")
 # MueLu reads its list only when it builds a preconditioner: capstan builds one before
 # the run when a scene passes its own (an unknown smoother, a value of the wrong type).
 for label, param in (("MueLu: unknown smoother", '<Parameter name="smoother: type" type="string" value="Bogus"/>'),
