@@ -9,7 +9,7 @@ must stay empty. Classes: wrong types, out-of-range values, wrong array lengths,
 unknown face names, a zero axis direction, Radius <= 0, malformed XML (unclosed,
 mismatched, duplicated, too deeply nested, unknown elements), an empty file,
 binary garbage, a missing scene file, an output directory under a regular file,
-bad NOX and Stratimikos sublists (MueLu's own parameters too), a mesh with fewer cells than ranks, and bad
+bad NOX and Stratimikos sublists (MueLu's own parameters too, MUMPS' Precision), a mesh with fewer cells than ranks, and bad
 --set values.
 
 Then the warning for a capstan that can never touch its contact faces: printed
