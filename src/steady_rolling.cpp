@@ -34,7 +34,8 @@ constexpr int kGuessPasses = 1;
 // their answer with Coulomb's stick (eps_t, its tangential penalty) this much
 // softer than the automatic one, then 3x that: softer than the default, and
 // stiffer than a scene's much softer stick (eps_t = 1, 300x the automatic on
-// the drive, did not converge in 50 passes at any load). The drive at mu = 1.1-2 failed (the Newton solve
+// the drive, did not converge in 50 passes at any load: now 209 Newton
+// iterations). The drive at mu = 1.1-2 failed (the Newton solve
 // stagnated at |R| ~1e-2, and so did friction at the held angular velocity);
 // through the retries mu = 1.1, 1.2, 1.3, 1.5 and 2 converge in 125, 134, 91,
 // 71 and 82 Newton iterations (10x alone left 1.2 failing; retries from the
