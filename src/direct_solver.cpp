@@ -147,7 +147,7 @@ void MumpsSolver::initialize(const Teuchos::Comm<int>& comm, bool hostOnly) {
   });
   impl_ = std::move(impl);  // from here on the destructor frees what there is
   run(-1);
-  if (const int e = impl_->with([](auto& id) { return INFOG(id, 1); }); e < 0) {
+  if (const int e = infog(1); e < 0) {
     if (impl_->hostComm != MPI_COMM_NULL) MPI_Comm_free(&impl_->hostComm);
     impl_.reset();  // no instance to free
     throw std::runtime_error("MUMPS initialisation failed: INFOG(1) = " + std::to_string(e));
@@ -458,7 +458,7 @@ void MumpsSolver::runFactorization() {
     m.setValues(m.a, m.size == 1);
   }
   run(2);
-  const int e = m.with([](auto& id) { return INFOG(id, 1); });
+  const int e = infog(1);
   if (e == -8 || e == -9) {
     // The analysis' estimate was short (delayed pivots): more room, once.
     m.with([](auto& id) { ICNTL(id, 14) = std::max(2 * ICNTL(id, 14), ICNTL(id, 14) + 50); });
@@ -474,10 +474,10 @@ void MumpsSolver::runFactorization() {
 // Runs JOB = job (0: only checks the last call's result) and throws on error.
 void MumpsSolver::call(int job, const char* phase) {
   if (job != 0) run(job);
-  const auto [e, e2] = impl_->with([](auto& id) { return std::pair(INFOG(id, 1), INFOG(id, 2)); });
+  const int e = infog(1);
   if (e < 0)
     throw std::runtime_error(std::string("MUMPS ") + phase + " failed: INFOG(1) = " + std::to_string(e) +
-                             ", INFOG(2) = " + std::to_string(e2) + explainInfog1(e));
+                             ", INFOG(2) = " + std::to_string(infog(2)) + explainInfog1(e));
 }
 
 void MumpsSolver::solve(const MultiVector& b, MultiVector& x) {
@@ -526,7 +526,7 @@ void MumpsSolver::run(int job) {
 
 std::int64_t MumpsSolver::factorEntries() const {
   if (!impl_) return 0;
-  const std::int64_t v = impl_->with([](auto& id) { return INFOG(id, 29); });
+  const std::int64_t v = infog(29);
   return v < 0 ? -v * 1000000 : v;  // negative: millions of entries
 }
 

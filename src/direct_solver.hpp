@@ -152,7 +152,7 @@ class MumpsSolver {
   double analyseWith(MumpsOptions::Ordering ordering);  // one analysis; returns its estimated flops
   void runFactorization();
   void call(int job, const char* phase);
-  int infog(int i) const;  // INFOG(i) of the last call, 0 before the first
+  int infog(int i) const;  // INFOG(i) of the last call (every rank), 0 before the instance exists
 
   MumpsOptions options_;
   std::unique_ptr<Impl> impl_;
