@@ -22,6 +22,13 @@ namespace {
 // against 66 but the 8x256 braked slice in 24 against 20, the rest within 1-4
 // either way (docs/steady-rolling.md has the table).
 constexpr double kStartSlipScales[] = {0.02, 0.004};
+// Tanh and Arctan scenes whose slip speed scale lies below the first stage's
+// by more than this ratio start through their own law at the stages' scales,
+// which go on falling by this ratio to about the scene's: the drive under Tanh
+// 1e-4 in 83 Newton iterations against 453 through friction at the held
+// angular velocity (docs/steady-rolling.md, "Tiny regularisation"); ratios of
+// 3 and 10 took 317 and 293 over five scenes against 288.
+constexpr double kStartStageRatio = 5;
 // The Tanh stages are starting guesses: one pass each, a Newton solve and the
 // saddle-point step (AugmentationLoop::solve's passLimit). The drive 43 Newton
 // iterations against 52 with each converged, the slice 18/22, the braked
@@ -62,14 +69,14 @@ bool SteadyRolling::startFromRest(double t, StepRecord& rec, std::string& failur
   predictors_.linearResponse(t, rec);
   if (!solveStage(t, "frictionless footprint", rec, failure)) return false;
   enableFriction(true);
-  const auto coulomb = coulombFrictions();
-  if (!coulomb.empty()) {
+  const auto widened = frictionsStartedWide();
+  if (!widened.empty()) {
     const auto footprint = m_.snapshot();
     std::string why;
-    if (startThroughTanh(t, coulomb, rec, why) && steadyStateWithStickRetries(t, coulomb, rec, why)) return true;
+    if (startThroughWideLaws(t, widened, rec, why) && steadyStateWithStickRetries(t, widened, rec, why)) return true;
     // Back to the footprint, for the start through friction at the held angular velocity.
     if (log_.on("newton"))
-      log_.event("newton", format("steady rolling: the start through Tanh failed (%s): from the footprint again",
+      log_.event("newton", format("steady rolling: the start through wider laws failed (%s): from the footprint again",
                                   why.c_str()),
                  json::Object().add("event", json::string("steady tanh start failed")));
     m_.restore(footprint);
@@ -80,13 +87,18 @@ bool SteadyRolling::startFromRest(double t, StepRecord& rec, std::string& failur
   return solveStage(t, "steady state", rec, failure);
 }
 
-bool SteadyRolling::steadyStateWithStickRetries(double t, const std::vector<SteadyFrictionEffect*>& coulomb,
+bool SteadyRolling::steadyStateWithStickRetries(double t, const std::vector<SteadyFrictionEffect*>& widened,
                                                 StepRecord& rec, std::string& failure) {
+  std::vector<SteadyFrictionEffect*> coulomb;
+  for (auto* f : widened)
+    if (f->augmented()) coulomb.push_back(f);
   const auto afterTanh = m_.snapshot();
-  // 0: the scene's stick; then kRetryStickSoftening and 3x that times the
-  // automatic one (softer than the automatic stick, and stiffer than a
-  // scene's much softer one).
-  for (double stick : {0.0, kRetryStickSoftening, 3 * kRetryStickSoftening}) {
+  // 0: the scene's stick; then (Coulomb) kRetryStickSoftening and 3x that
+  // times the automatic one (softer than the automatic stick, and stiffer
+  // than a scene's much softer one).
+  const std::vector<double> sticks = coulomb.empty() ? std::vector<double>{0.0}
+                                                     : std::vector<double>{0.0, kRetryStickSoftening, 3 * kRetryStickSoftening};
+  for (double stick : sticks) {
     for (auto* f : coulomb) f->setStick(stick);
     bool ok = solveStage(t, "steady state", rec, failure);
     for (auto* f : coulomb) f->setStick(0.0);
@@ -105,25 +117,46 @@ bool SteadyRolling::steadyStateWithStickRetries(double t, const std::vector<Stea
   return false;
 }
 
-std::vector<SteadyFrictionEffect*> SteadyRolling::coulombFrictions() const {
-  std::vector<SteadyFrictionEffect*> coulomb;
-  for (auto* f : m_.assembly->frictions())
-    if (auto* steady = dynamic_cast<SteadyFrictionEffect*>(f); steady && steady->augmented()) coulomb.push_back(steady);
-  return coulomb;
+std::vector<SteadyFrictionEffect*> SteadyRolling::frictionsStartedWide() const {
+  std::vector<SteadyFrictionEffect*> widened;
+  for (auto* f : m_.assembly->frictions()) {
+    auto* steady = dynamic_cast<SteadyFrictionEffect*>(f);
+    if (!steady) continue;
+    const double fraction = steady->sceneSlipFraction();
+    if (steady->augmented() || (fraction > 0 && fraction < kStartSlipScales[0] / kStartStageRatio))
+      widened.push_back(steady);
+  }
+  return widened;
 }
 
-bool SteadyRolling::startThroughTanh(double t, const std::vector<SteadyFrictionEffect*>& coulomb, StepRecord& rec,
-                                     std::string& failure) {
+std::vector<double> SteadyRolling::startSlipScales(const std::vector<SteadyFrictionEffect*>& widened) {
+  std::vector<double> scales(std::begin(kStartSlipScales), std::end(kStartSlipScales));
+  double narrowest = std::numeric_limits<double>::infinity();
+  for (auto* f : widened)
+    if (!f->augmented()) narrowest = std::min(narrowest, f->sceneSlipFraction());
+  while (scales.back() / kStartStageRatio > kStartStageRatio * narrowest / 2)
+    scales.push_back(scales.back() / kStartStageRatio);
+  return scales;
+}
+
+bool SteadyRolling::startThroughWideLaws(double t, const std::vector<SteadyFrictionEffect*>& widened, StepRecord& rec,
+                                         std::string& failure) {
   holdCores(false);
   bool ok = true;
-  for (double scale : kStartSlipScales) {
-    for (auto* f : coulomb) f->useTanh(scale);
-    const std::string stage = format("Tanh of slip speed %g x the capstan's in Coulomb's place", scale);
+  for (double scale : startSlipScales(widened)) {
+    int wider = 0;
+    for (auto* f : widened) {
+      if (!f->augmented() && scale <= f->sceneSlipFraction()) continue;  // not wider than its own
+      f->useStartLaw(scale);
+      ++wider;
+    }
+    if (wider == 0) break;
+    const std::string stage = format("start: slip speed scale %g x the capstan's (Tanh in Coulomb's place)", scale);
     ok = solveStage(t, stage.c_str(), rec, failure, kGuessPasses);
     if (!ok) break;
   }
   if (ok) m_.assembly->evaluate(*m_.u, nullptr, nullptr);  // the tractions Coulomb starts from
-  for (auto* f : coulomb) f->useCoulomb(ok);
+  for (auto* f : widened) f->useSceneLaw(ok);
   return ok;
 }
 

@@ -2,10 +2,11 @@
 // from the previous one (a continuation in the loads). The first comes from
 // rest without the user's help: the frictionless footprint (from the linear
 // response to the loads, as a quasi-static first step) with each free core's
-// angular velocity held at the no-slip value; then, under Coulomb, Tanh laws
-// of falling slip scale with the angular velocity free, whose tractions seed
-// Coulomb's stick multipliers (Tanh and Arctan scenes, or where that fails:
-// friction at the held angular velocity); then the steady state.
+// angular velocity held at the no-slip value; then, with the angular velocity
+// free, laws of falling slip scale: Tanh in Coulomb's place, whose tractions
+// seed Coulomb's stick multipliers, or a narrow Tanh or Arctan scene's own law
+// (wider Tanh and Arctan scenes, or where that fails: friction at the held
+// angular velocity); then the steady state.
 #pragma once
 
 #include <string>
@@ -35,16 +36,22 @@ class SteadyRolling {
   // kRetryStickSoftening); where those fail, from the footprint again through
   // friction at the held angular velocity, then the steady state.
   bool startFromRest(double t, StepRecord& rec, std::string& failure);
-  std::vector<SteadyFrictionEffect*> coulombFrictions() const;
-  // Omega free and the Tanh stages (kStartSlipScales) in Coulomb's place;
-  // Coulomb again after them, its multipliers their tractions if they converged.
-  bool startThroughTanh(double t, const std::vector<SteadyFrictionEffect*>& coulomb, StepRecord& rec,
-                        std::string& failure);
-  // Coulomb's steady state from the Tanh stages' answer, with the scene's
-  // stick and, where that fails, sticks kRetryStickSoftening x and 3x the
+  // Coulomb's frictions, and Tanh and Arctan ones much narrower than the
+  // first start stage: those the start widens.
+  std::vector<SteadyFrictionEffect*> frictionsStartedWide() const;
+  // The start stages' slip speed scales over the capstan's surface speed:
+  // kStartSlipScales, then on down to about the narrowest regularised law's.
+  static std::vector<double> startSlipScales(const std::vector<SteadyFrictionEffect*>& widened);
+  // Omega free and the start stages: Tanh in Coulomb's place, a Tanh or Arctan
+  // scene's law at the stage's scale where wider than its own; the scene's
+  // laws again after them, Coulomb's multipliers their tractions if they converged.
+  bool startThroughWideLaws(double t, const std::vector<SteadyFrictionEffect*>& widened, StepRecord& rec,
+                            std::string& failure);
+  // The steady state from the start stages' answer, with the scene's stick
+  // and, where Coulomb's fails, sticks kRetryStickSoftening x and 3x the
   // automatic one (then the scene's stick from their answer). False, with u and the
-  // multipliers at the Tanh answer, if all three fail.
-  bool steadyStateWithStickRetries(double t, const std::vector<SteadyFrictionEffect*>& coulomb, StepRecord& rec,
+  // multipliers at the start stages' answer, if all fail.
+  bool steadyStateWithStickRetries(double t, const std::vector<SteadyFrictionEffect*>& widened, StepRecord& rec,
                                    std::string& failure);
   // passLimit > 0: a starting guess, that many augmentation passes.
   bool solveStage(double t, const char* what, StepRecord& rec, std::string& failure, int passLimit = 0);

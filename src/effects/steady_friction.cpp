@@ -99,24 +99,35 @@ SteadyFrictionEffect::SteadyFrictionEffect(const std::string& name, const Mesh& 
   local_.R = Matrix("steady friction R", nf, 3 * kNodes);
 }
 
-void SteadyFrictionEffect::useTanh(double speedFraction) {
-  const double regularization = speedFraction * std::abs(contact_.capstan().angularVelocity * contact_.radius());
-  if (!tanhStart_) {
-    if (settings_.law != FrictionSettings::Law::Coulomb)
-      throw std::logic_error("steady friction: a Tanh start replaces Coulomb only");
-    sceneRegularization_ = settings_.regularization;
-    tanhStart_ = true;
-  }
-  settings_.law = FrictionSettings::Law::Tanh;
-  settings_.regularization = regularization;
-  parameters_.law = kernels::FrictionLaw::Tanh;
+double SteadyFrictionEffect::surfaceSpeed() const {
+  return std::abs(contact_.capstan().angularVelocity * contact_.radius());
 }
 
-void SteadyFrictionEffect::useCoulomb(bool seed) {
-  if (!tanhStart_) return;
-  tanhStart_ = false;
-  settings_.law = FrictionSettings::Law::Coulomb;
+double SteadyFrictionEffect::sceneSlipFraction() const {
+  const auto law = startLaw_ ? sceneLaw_ : settings_.law;
+  if (law == FrictionSettings::Law::Coulomb || law == FrictionSettings::Law::None) return 0;
+  return (startLaw_ ? sceneRegularization_ : settings_.regularization) / surfaceSpeed();
+}
+
+void SteadyFrictionEffect::useStartLaw(double speedFraction) {
+  if (!startLaw_) {
+    sceneLaw_ = settings_.law;
+    sceneRegularization_ = settings_.regularization;
+    startLaw_ = true;
+  }
+  if (sceneLaw_ == FrictionSettings::Law::Coulomb) {
+    settings_.law = FrictionSettings::Law::Tanh;
+    parameters_.law = kernels::FrictionLaw::Tanh;
+  }
+  settings_.regularization = speedFraction * surfaceSpeed();
+}
+
+void SteadyFrictionEffect::useSceneLaw(bool seed) {
+  if (!startLaw_) return;
+  startLaw_ = false;
   settings_.regularization = sceneRegularization_;
+  if (sceneLaw_ != FrictionSettings::Law::Coulomb) return;
+  settings_.law = FrictionSettings::Law::Coulomb;
   parameters_.law = kernels::FrictionLaw::Coulomb;
   // lambda_T = t. Tried: lambda_T = t - du_t / eps_t, which makes Coulomb's
   // trial traction at this state Tanh's traction (every point starts sticking

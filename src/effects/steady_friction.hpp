@@ -48,14 +48,17 @@ class SteadyFrictionEffect : public FrictionEffect {
   void constraintRows(const NodalVectors& x, ConstraintRows& rows) const override;
   // Steady rolling's start: friction off (a frictionless footprint first).
   void setEnabled(bool on) { enabled_ = on; }
-  // Steady rolling's start from rest under Coulomb (src/steady_rolling.cpp):
-  // Tanh in Coulomb's place, its slip speed scale (Friction/Regularization)
+  // Steady rolling's start from rest (src/steady_rolling.cpp): a wider law in
+  // the scene's place, of slip speed scale (Friction/Regularization)
   // `speedFraction` of the capstan's surface speed (so the start does not
-  // depend on the speed, as Coulomb does not); then Coulomb again, where
-  // `seed` with the last evaluation's tractions as its multipliers (else they
-  // are left as they are).
-  void useTanh(double speedFraction);
-  void useCoulomb(bool seed);
+  // depend on the speed): Tanh in Coulomb's place, or the scene's Tanh or
+  // Arctan with that scale. useSceneLaw() ends it: the scene's law again,
+  // Coulomb's multipliers where `seed` the last evaluation's tractions (else
+  // they are left as they are).
+  void useStartLaw(double speedFraction);
+  void useSceneLaw(bool seed);
+  // The scene's slip speed scale over the capstan's surface speed; 0 under Coulomb.
+  double sceneSlipFraction() const;
   // Coulomb's tangential penalty eps_t (the stick's slope, not where it ends:
   // the multipliers make it exact either way): `factor` x the automatic value
   // (the contact's solve penalty), or the scene's with factor 0.
@@ -82,9 +85,11 @@ class SteadyFrictionEffect : public FrictionEffect {
   double axisSign_ = 1;    // the core's axis direction . z
   double sigma_ = 1;       // sign of the flow about +z
   bool enabled_ = true;
-  double sceneRegularization_ = 0;  // while useTanh() holds
+  double sceneRegularization_ = 0;  // while useStartLaw() holds
+  FrictionSettings::Law sceneLaw_ = FrictionSettings::Law::Coulomb;
   double sceneTangentPenalty_ = 0;
-  bool tanhStart_ = false;
+  bool startLaw_ = false;
+  double surfaceSpeed() const;
 };
 
 }  // namespace capstan

@@ -23,6 +23,11 @@ first order).
   * the steady 3D drive with a very soft stick (Tangential Penalty = 1, 300x the automatic
     value): the augmentation loop does not converge with it, the retry with a stick 10x the
     automatic one does and the scene's stick holds from there; against the shipped scene;
+  * the steady 3D drive under Tanh with Regularization = 1e-4 (a slip speed scale 2e-6 of
+    the capstan's surface speed): its start from rest goes through its own law at wider
+    scales (SteadyRolling::startThroughWideLaws; 453 Newton iterations before, through
+    friction at the held angular velocity and the continuation), against Coulomb (the
+    shipped scene);
   * the steady 3D drive pressed 8x harder (32 N, ramped in 1e-6 s of its one 1e-3 s step): the
     start from rest fails at the full force, and the step's cuts go to the loads (half the
     force first, LoadStepper::advance), against the force ramped over two steps.
@@ -41,6 +46,7 @@ MU12 = "Capstans/capstan/Friction/Coefficient=1.2"
 NOFIELDS = "Output/Write Fields=false"
 F8 = "Supports/core/Force={0, -32, 0}"
 EPST1 = "Capstans/capstan/Friction/Tangential Penalty=1"
+TANH4 = ["Capstans/capstan/Friction/Law=Tanh", "Capstans/capstan/Friction/Regularization=1e-4"]
 
 # name, scene, settings, reference settings, max penetration, Newton budget
 CASES = [
@@ -68,6 +74,7 @@ CASES = [
     ("steady drive mu = 1.2", "pinch-roller-steady.xml", [MU12, NOFIELDS], [MU12, NOFIELDS,
      "Capstans/capstan/Friction/Tangential Penalty=3.4e-2"], 5e-5, 300),
     ("steady drive eps_t = 1", "pinch-roller-steady.xml", [EPST1, NOFIELDS], [NOFIELDS], 5e-5, 300),
+    ("steady drive Tanh eps3 = 1e-4", "pinch-roller-steady.xml", TANH4 + [NOFIELDS], [NOFIELDS], 5e-5, 150),
     ("steady drive 8x force", "pinch-roller-steady.xml", [F8, NOFIELDS], [F8, NOFIELDS, "Time/Steps=2",
      "Supports/core/Force Ramp Time=0.002"], 5e-5, 1500),
 ]
