@@ -21,6 +21,13 @@ RegularisationContinuation::RegularisationContinuation(const std::vector<Frictio
   if (ratio > 9) stages_ = int(std::ceil(std::log(ratio / 3) / std::log(3.0)));
 }
 
+bool RegularisationContinuation::canRetry() const {
+  const auto acting = [](const FrictionEffect* f) { return f->acting(); };
+  if (stages_ > 0) return std::any_of(frictions_.begin(), frictions_.end(), acting);
+  return std::any_of(corners_.begin(), corners_.end(),
+                     [](const FrictionEffect* f) { return f->acting() && f->exactCorner(); });
+}
+
 void RegularisationContinuation::setScale(double scale) {
   for (auto* f : frictions_) f->setRegularisationScale(scale);
 }

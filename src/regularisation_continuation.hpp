@@ -47,6 +47,10 @@ class RegularisationContinuation {
   bool applies() const { return stages_ > 0 || !corners_.empty(); }
   // Whether it widens a regularised law (else: Coulomb's corner only).
   bool regularised() const { return stages_ > 0; }
+  // Whether a retry can change a failed solve now: a regularised law or
+  // Coulomb's exact corner in force (not friction switched off, nor Tanh in
+  // Coulomb's place: steady rolling's start, src/steady_rolling.cpp).
+  bool canRetry() const;
   // The solve through the stages from u (the failed solve's start, in place):
   // the short sequence, then if it fails the whole one. The iterations of
   // every stage are summed in the result.

@@ -27,6 +27,8 @@ class FrictionEffect : public Effect {
   // width for the retry (0: the scene's own again; RegularisationContinuation).
   bool exactCorner() const { return settings_.law == FrictionSettings::Law::Coulomb && settings_.smoothing == 0; }
   void setCornerSmoothing(double delta) { parameters_.smoothing = delta; }
+  // Whether the law acts now (steady rolling's frictionless footprint turns it off).
+  virtual bool acting() const { return true; }
   // Tanh and Arctan: the capstan surface's travel over the slip scale v
   // (scale 1), (|omega| R + |velocity|) / eps3, independent of dt; 0 otherwise.
   double travelOverSlipScale() const;

@@ -48,6 +48,7 @@ class SteadyFrictionEffect : public FrictionEffect {
   void constraintRows(const NodalVectors& x, ConstraintRows& rows) const override;
   // Steady rolling's start: friction off (a frictionless footprint first).
   void setEnabled(bool on) { enabled_ = on; }
+  bool acting() const override { return enabled_; }
   // Steady rolling's start from rest (src/steady_rolling.cpp): a wider law in
   // the scene's place, of slip speed scale (Friction/Regularization)
   // `speedFraction` of the capstan's surface speed (so the start does not
