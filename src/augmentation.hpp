@@ -82,9 +82,16 @@ class AugmentationLoop {
     bool volumeMet = true;  // the bricks' volumes
     bool rowsUnmet = false; // some effect with rows of its own in the step (contact, stick) is not
     std::vector<const Effect*> settled;  // rolling: effects within tolerance, whose multipliers stay put
+    double worst = 0;       // the largest violation over its tolerance
+    std::string worstName;  // whose
   };
 
   Pass startPass(int it, double tol, PassPolicy& passes, Vector& f);
+  // With the saddle-point step: whether the worst constraint has not come
+  // below its best for kStallPasses passes (failure set).
+  bool stalled(int it, const Constraints& c, std::string& failure);
+  double bestWorst_ = 0;
+  int bestPass_ = 0;
   // The pass's Newton solve on the positions (none for a step alone), with
   // the friction retries (through wider laws, in pseudo-time) where it fails.
   // afterStep: the pass follows a saddle-point step (which is undone instead).
