@@ -29,6 +29,12 @@ constexpr double kStartSlipScales[] = {0.02, 0.004};
 // angular velocity (docs/steady-rolling.md, "Tiny regularisation"); ratios of
 // 3 and 10 took 317 and 293 over five scenes against 288.
 constexpr double kStartStageRatio = 5;
+// A start stage that fails is tried again from the last one's answer after a
+// stage halfway (in log) between them (the first: after one 5x wider), this
+// many times in a start: the drive at 8x its force, whose 0.004 stage failed,
+// in 261 Newton iterations with no cut against 868 and 3 cuts (4 refinements
+// at 10x: no better; docs/steady-rolling.md, "Large indentation").
+constexpr int kStageRefinements = 2;
 // The Tanh stages are starting guesses: one pass each, a Newton solve and the
 // saddle-point step (AugmentationLoop::solve's passLimit). The drive 43 Newton
 // iterations against 52 with each converged, the slice 18/22, the braked
@@ -58,9 +64,24 @@ SteadyRolling::SteadyRolling(Model& model, Log& log, AugmentationLoop& augmentat
     : m_(model), log_(log), augmentation_(augmentation), predictors_(predictors), started_(started) {}
 
 bool SteadyRolling::solve(double t, StepRecord& rec, std::string& failure) {
-  const bool ok = started_ ? solveStage(t, "steady state", rec, failure) : startFromRest(t, rec, failure);
-  started_ = started_ || ok;
-  return ok;
+  if (!started_) return started_ = startFromRest(t, rec, failure);
+  const auto before = m_.snapshot();
+  if (solveStage(t, "steady state", rec, failure)) return !(wideRetryUsed_ = false);
+  // The last steady state is too far from this one for Coulomb's exact stick
+  // to sort stick and slip from: once until a step converges, from it again
+  // through the start's wider laws, before the step is cut.
+  const auto widened = frictionsStartedWide();
+  if (widened.empty() || wideRetryUsed_) return false;
+  wideRetryUsed_ = true;
+  if (log_.on("newton"))
+    log_.event("newton", format("steady rolling: the steady state failed (%s): again through wider laws", failure.c_str()),
+               json::Object().add("event", json::string("steady state failed")));
+  m_.restore(before);
+  std::string why;
+  if (startThroughWideLaws(t, widened, rec, why) && steadyStateWithStickRetries(t, widened, rec, why))
+    return !(wideRetryUsed_ = false);
+  failure += "; again through wider laws: " + why;
+  return false;
 }
 
 bool SteadyRolling::startFromRest(double t, StepRecord& rec, std::string& failure) {
@@ -143,7 +164,10 @@ bool SteadyRolling::startThroughWideLaws(double t, const std::vector<SteadyFrict
                                          std::string& failure) {
   holdCores(false);
   bool ok = true;
-  for (double scale : startSlipScales(widened)) {
+  std::vector<double> scales = startSlipScales(widened);
+  int refinements = 0;
+  for (int k = 0; k < int(scales.size()); ++k) {
+    const double scale = scales[k];
     int wider = 0;
     for (auto* f : widened) {
       if (!f->augmented() && scale <= f->sceneSlipFraction()) continue;  // not wider than its own
@@ -151,9 +175,18 @@ bool SteadyRolling::startThroughWideLaws(double t, const std::vector<SteadyFrict
       ++wider;
     }
     if (wider == 0) break;
+    const auto before = m_.snapshot();
     const std::string stage = format("start: slip speed scale %g x the capstan's (Tanh in Coulomb's place)", scale);
     ok = solveStage(t, stage.c_str(), rec, failure, kGuessPasses);
-    if (!ok) break;
+    if (ok) continue;
+    if (refinements == kStageRefinements) break;
+    // From the last stage's answer again, through a stage halfway (in log) to
+    // this one (the first: from the footprint through a wider one).
+    m_.restore(before);
+    scales.insert(scales.begin() + k, k == 0 ? scale * kStartStageRatio : std::sqrt(scales[k - 1] * scale));
+    ++refinements;
+    ok = true;
+    --k;
   }
   if (ok) m_.assembly->evaluate(*m_.u, nullptr, nullptr);  // the tractions Coulomb starts from
   for (auto* f : widened) f->useSceneLaw(ok);

@@ -26,8 +26,10 @@ class SteadyRolling {
  public:
   // started: u already holds a steady state (a restart).
   SteadyRolling(Model& model, Log& log, AugmentationLoop& augmentation, Predictors& predictors, bool started);
-  // The steady state at the loads of time t, from the one in u. False with
-  // `failure` as AugmentationLoop::solve (the caller restores u).
+  // The steady state at the loads of time t, from the one in u (where that
+  // fails, once until a step converges: from it again through the start's
+  // wider laws). False with `failure` as AugmentationLoop::solve (the caller
+  // restores u).
   bool solve(double t, StepRecord& rec, std::string& failure);
 
  private:
@@ -63,6 +65,7 @@ class SteadyRolling {
   AugmentationLoop& augmentation_;
   Predictors& predictors_;
   bool started_;
+  bool wideRetryUsed_ = false;  // since the last converged steady state
 };
 
 }  // namespace capstan
