@@ -49,6 +49,8 @@ Model::Model(const Scene& scene_, const RCP<const Comm>& comm_)
     pressureStep = std::make_unique<PressureStep>(
         *assembly, laplacian ? PressureStep::Schur::Laplacian : PressureStep::Schur::Diagonal);
     monolithic = scene.solver.monolithic && !(scene.solver.monolithicIfExact && newton->iterative());
+    if (monolithic && scene.solver.minimumSolvePenaltyAutomatic)
+      assembly->bricks().setSolvePenalty(std::max(scene.pressurePenalty, S::kMonolithicSolvePenalty / scene.c));
   }
   u = rcp(new Vector(assembly->dofMap()));
   for (const auto& core : assembly->rigidCores()) rolling = rolling || core.free[3];

@@ -77,7 +77,8 @@ void SolverSettings::declare(ParameterList& sol) {
   sol.set("Minimum Solve Penalty", -1.0,
           "Smallest eps1 x c used in the Newton solves: below it the condensed pressure "
           "cannot be evaluated in double precision; the pressure loop still makes v_e = V_e exact. "
-          "-1: automatic, 3e-2 with the Saddle Point pressure update without friction, 1e-2 otherwise");
+          "-1: automatic, 3e-2 with the Saddle Point pressure update without friction, 1e-2 otherwise "
+          "(and where the pressure loop is monolithic)");
   sol.sublist("NOX", false, "Passed to NOX unchanged, over capstan's defaults");
   sol.sublist("Stratimikos", false, "Passed to Stratimikos unchanged, over capstan's defaults");
 }
@@ -153,11 +154,15 @@ SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterRe
   // Automatic: the fastest on G1 for each update (docs/performance.md,
   // "Defaults and why"): 3e-2 with the saddle-point step, 1e-2 with Anderson;
   // with friction 1e-2 (the fast rollers: 51.7 Newton iterations per step
-  // against 68.1 at 3e-2, docs/friction.md).
+  // against 68.1 at 3e-2, docs/friction.md); the monolithic loop 1e-2
+  // (kMonolithicSolvePenalty, set by Model: G1 2x 204 GMRES iterations against
+  // 267, 2.09 s against 2.39 s, the Hertz ring 102 against 132; 2e-2, 7e-3 and
+  // 5e-3 took more).
   s.minimumSolvePenalty = sol.get<double>("Minimum Solve Penalty");
   if (!(s.minimumSolvePenalty > 0 || s.minimumSolvePenalty == -1) || !std::isfinite(s.minimumSolvePenalty))
     r.fail("Solver/Minimum Solve Penalty", "must be > 0, or -1 (automatic), got " + Teuchos::toString(s.minimumSolvePenalty));
-  if (s.minimumSolvePenalty == -1)
+  s.minimumSolvePenaltyAutomatic = s.minimumSolvePenalty == -1;
+  if (s.minimumSolvePenaltyAutomatic)
     s.minimumSolvePenalty = s.pressureUpdate == PressureUpdate::SaddlePoint && !friction ? 3e-2 : 1e-2;
   s.nox = sol.sublist("NOX");
   s.stratimikos = sol.sublist("Stratimikos");

@@ -51,6 +51,10 @@ struct SolverSettings {
   Schur pressureStepSchur{};
   int pressureAccelerationDepth = 0;
   double minimumSolvePenalty = 0;  // resolved: > 0
+  // Automatic (-1): Model lowers it to kMonolithicSolvePenalty where the loop
+  // turns out monolithic (it knows the linear solver).
+  bool minimumSolvePenaltyAutomatic = false;
+  static constexpr double kMonolithicSolvePenalty = 1e-2;
   // Set by resolved() for an annulus: MueLu with symmetric Gauss-Seidel
   // smoothing and a drop tolerance, which suit graded rings (src/newton.cpp).
   bool gradedRings = false;

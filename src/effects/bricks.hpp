@@ -19,6 +19,8 @@ class BrickEffect : public Effect {
   // The penalty eps of the Newton solves (the scene's eps1, raised to
   // Solver/Minimum Solve Penalty).
   double solvePenalty() const { return penalty_; }
+  // Model raises the automatic floor for the monolithic loop (src/model.cpp).
+  void setSolvePenalty(double eps) { penalty_ = eps; }
   // d v_e / d x at positions x (overlapped nodes), 24 per element (dof 3a+i).
   void volumeGradients(const NodalVectors& x, Matrix& g) const;
   // c_e = v_e - V_e with the anchor pbar_e: force -1 (dR/dpbar = -g_e),
