@@ -64,9 +64,15 @@ SteadyRolling::SteadyRolling(Model& model, Log& log, AugmentationLoop& augmentat
     : m_(model), log_(log), augmentation_(augmentation), predictors_(predictors), started_(started) {}
 
 bool SteadyRolling::solve(double t, StepRecord& rec, std::string& failure) {
-  if (!started_) return started_ = startFromRest(t, rec, failure);
+  if (!started_) {
+    started_ = startFromRest(t, rec, failure);
+    return started_;
+  }
   const auto before = m_.snapshot();
-  if (solveStage(t, "steady state", rec, failure)) return !(wideRetryUsed_ = false);
+  if (solveStage(t, "steady state", rec, failure)) {
+    wideRetryUsed_ = false;
+    return true;
+  }
   // The last steady state is too far from this one for Coulomb's exact stick
   // to sort stick and slip from: once until a step converges, from it again
   // through the start's wider laws, before the step is cut.
@@ -78,8 +84,10 @@ bool SteadyRolling::solve(double t, StepRecord& rec, std::string& failure) {
                json::Object().add("event", json::string("steady state failed")));
   m_.restore(before);
   std::string why;
-  if (startThroughWideLaws(t, widened, rec, why) && steadyStateWithStickRetries(t, widened, rec, why))
-    return !(wideRetryUsed_ = false);
+  if (startThroughWideLaws(t, widened, rec, why) && steadyStateWithStickRetries(t, widened, rec, why)) {
+    wideRetryUsed_ = false;
+    return true;
+  }
   failure += "; again through wider laws: " + why;
   return false;
 }
