@@ -324,7 +324,7 @@ void MumpsSolver::analyse(const CrsMatrix& A) {
       id.irn = m.irnAll.data();
       id.jcn = m.jcnAll.data();
     });
-  } else if (m.size == 1) {
+  } else if (m.centralised()) {
     m.with([&](auto& id) {
       id.nnz = static_cast<MUMPS_INT8>(nnz);
       id.irn = m.irn.data();
@@ -455,7 +455,7 @@ void MumpsSolver::runFactorization() {
                 m.nnzOffsets.data(), MPI_DOUBLE, 0, m.comm);
     if (m.runsMumps()) m.setValues(m.aAll, true);
   } else {
-    m.setValues(m.a, m.size == 1);
+    m.setValues(m.a, m.centralised());
   }
   run(2);
   const int e = infog(1);
