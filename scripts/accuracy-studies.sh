@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# The accuracy studies of docs/accuracy.md: G1 and H1, every knob, with scripts/study.py.
-#   scripts/accuracy-studies.sh            (about 30 min on 2 cores; the G1 4x mesh
+# The accuracy studies of docs/accuracy.md: G1 and H1, every knob, with scripts/study.py,
+# and the pinch-roller nip's speed ratio with scripts/nip-accuracy.py.
+#   scripts/accuracy-studies.sh            (about 45 min on 2 cores; the G1 4x mesh
 #                                           alone takes ~18 min and is taken from
 #                                           out/g1-refine-4 when scripts/g1-refinement.sh
 #                                           has already run it)
@@ -40,6 +41,11 @@ study inputs/seed/h1.xml --out out/study-h1 --columns $contact,xmin_mean_ux \
 study inputs/seed/stick-slip.xml --out out/study-stick-slip --columns $contact,xmin_mean_ux --sweep steps=1,2,4,8
 # A smooth problem (no contact): the element's own convergence orders.
 study inputs/gravity.xml --out out/study-gravity --columns max_ux,max_uy,sigma_yy_min,von_mises_max --set "Mesh/Cells={8,8,1}" --sweep mesh=1,2,4
+
+# The pinch-roller slice's speed ratio, steady (mesh phases) and quasi-static (steps),
+# free and braked at 0.3 N mm/mm (about 7 min each).
+/usr/bin/python3 scripts/nip-accuracy.py --out out/nip-accuracy --png docs/img/accuracy-nip.png
+/usr/bin/python3 scripts/nip-accuracy.py --torque 0.3 --out out/nip-accuracy-brake --png docs/img/accuracy-nip-brake.png
 
 # The presets (Draft, Standard, Fine) on G1 and H1: error and wall time. Standard and
 # Fine are the 2x and 4x meshes of the mesh sweeps above (same settings): reused.

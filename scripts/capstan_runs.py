@@ -11,6 +11,9 @@ CAPSTAN = os.path.join(ROOT, "build", "capstan")
 # The scaling cases: scene and the cells of the 1x mesh (refined by a factor
 # in every direction).
 CASES = {"G1": ("inputs/seed/g1.xml", (14, 4, 6)), "H1": ("inputs/seed/h1.xml", (20, 2, 1))}
+# The slice scenes' Mesh/Fine Sector (inputs/pinch-roller-*slice*.xml, -braked*.xml):
+# centre, width (deg), fraction of the circumferential cells in it.
+SECTOR = (-65.0, 60.0, 0.6)
 ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
 
 
@@ -29,6 +32,13 @@ def command(capstan, scene, out, cells, ranks, sets=(), steps=0):
     if ranks > 1:
         cmd = ["mpiexec", "--oversubscribe", "-n", str(ranks)] + cmd
     return cmd
+
+
+def fine_cell(nt):
+    """(cells in the sector, fine cell angle in degrees) for nt circumferential cells, as
+    AnnulusGenerator does it (std::lround, clamped to 1 .. nt-1)."""
+    m = min(max(int(SECTOR[2] * nt + 0.5), 1), nt - 1)
+    return m, SECTOR[1] / m
 
 
 def run_scene(capstan, scene, out, sets=()):

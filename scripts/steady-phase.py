@@ -22,10 +22,9 @@ import math
 import os
 import sys
 
-from capstan_runs import ROOT, pyplot, run_scene
+from capstan_runs import ROOT, SECTOR, fine_cell, pyplot, run_scene
 
 SCENE = "pinch-roller-braked-steady.xml"
-SECTOR = (-65.0, 60.0, 0.6)  # the scene's Mesh/Fine Sector: centre, width (deg), cell fraction
 # Quasi-static reference: the mean speed ratio over the second half of a transient run of the
 # slice (the mesh rolls through the nip, so the mean is over all phases). 4x64x1: the brake
 # table of docs/pinch-roller.md (free: its refinement table); 8x128x1: the free roller from
@@ -33,13 +32,6 @@ SECTOR = (-65.0, 60.0, 0.6)  # the scene's Mesh/Fine Sector: centre, width (deg)
 # the steady-against-quasi-static table in docs/steady-rolling.md.
 QS = {"4x64": {0.0: 0.98961, 0.15: 0.98357, 0.3: 0.97809, 0.6: 0.96714, 1.0: 0.93633},
       "8x128": {0.0: 0.99125, 0.15: 0.98493, 0.3: 0.97713, 0.6: 0.96048, 1.0: 0.93190}}
-
-
-def fine_cell(nt):
-    """(cells in the sector, fine cell angle in degrees) for nt circumferential cells, as
-    AnnulusGenerator does it (std::lround, clamped to 1 .. nt-1)."""
-    m = min(max(math.floor(SECTOR[2] * nt + 0.5), 1), nt - 1)
-    return m, SECTOR[1] / m
 
 
 def steady(capstan, out, cells, torque, centre):

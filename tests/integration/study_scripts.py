@@ -13,6 +13,14 @@ one load step, two rounds (1 rank, 2 ranks with METIS, 2 ranks with Slabs):
   * a second call with the same --out reuses the runs (no summary.json rewritten)
     and may add rounds;
   * the PNGs are written.
+
+scripts/nip-accuracy.py on the slice (steady 4x64 and 8x128 at 2 mesh phases, a
+12-step quasi-static run):
+
+  * phase 0 is the shipped mesh: its speed ratio is a plain steady run's;
+  * the quasi-static figure is the mean over the run's second half, and every error
+    in the CSV is |speed ratio - reference| with the reference (two meshes: the finer
+    phase mean) stated in the report.
 """
 import csv
 import json
@@ -101,5 +109,34 @@ if len(runs) == 6:
                 f"speedup.md, {part}: speed-ups and mean {stated} (from the summaries: "
                 f"{[round(x, 3) for x in want]})")
 T.check(os.path.getsize(os.path.join(out, "speedup.png")) > 10000, "speedup.png written")
+
+# --- nip-accuracy.py ---------------------------------------------------------
+out = T.path("nip-accuracy")
+script("nip-accuracy.py", "--out", out, "--steady", "4x64,8x128", "--phases", "2", "--quasi-static", "4x64:1",
+       "--window", "6", "--png", os.path.join(out, "nip.png"))
+with open(os.path.join(out, "nip-accuracy.csv")) as fh:
+    rows = list(csv.DictReader(fh))
+T.check([(r["analysis"], r["mesh"]) for r in rows] ==
+        [("steady", "4x64")] * 2 + [("steady", "8x128")] * 2 + [("quasi-static", "4x64")],
+        f"nip-accuracy.csv rows {[(r['analysis'], r['mesh'], r['phase']) for r in rows]}")
+_, plain, _ = T.run_scene(T.input("pinch-roller-braked-steady.xml"), "nip-plain",
+                          sets=["Supports/core/Torque=0", "Supports/core/Torque Ramp Time=0.002", "Time/Steps=2",
+                                "Output/Write Fields=false"])
+want = plain["steps"][-1]["supports"]["core"]["speed_ratio"] if plain else float("nan")
+if len(rows) == 5:
+    T.check(abs(float(rows[0]["speed_ratio"]) - want) < 1e-12,
+            f"phase 0 is the shipped mesh: {float(rows[0]['speed_ratio']):.9f} against a plain run's {want:.9f}")
+    T.check(abs(float(rows[1]["speed_ratio"]) - want) > 1e-5, "phase 1 is another mesh: another speed ratio")
+    with open(os.path.join(out, "quasi-static", "4x64-dt1", "summary.json")) as fh:
+        steps = json.load(fh)["steps"]
+    late = [st["supports"]["core"]["speed_ratio"] for st in steps[6:]]
+    T.check(len(steps) == 12 and abs(float(rows[4]["speed_ratio"]) - sum(late) / 6) < 1e-12,
+            f"quasi-static: {len(steps)} steps, mean of the last 6 {float(rows[4]['speed_ratio']):.6f}")
+    ref = (float(rows[2]["speed_ratio"]) + float(rows[3]["speed_ratio"])) / 2
+    T.check(all(abs(float(r["error"]) - abs(float(r["speed_ratio"]) - ref)) < 1e-12 for r in rows),
+            f"errors against the finer phase mean {ref:.6f}")
+    with open(os.path.join(out, "nip-accuracy.md")) as fh:
+        T.check(f"Reference speed ratio {ref:.6f}: the finest phase mean" in fh.read(), "the report states the reference")
+T.check(os.path.getsize(os.path.join(out, "nip.png")) > 10000, "nip-accuracy's PNG written")
 
 T.finish()
