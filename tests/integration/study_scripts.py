@@ -21,6 +21,10 @@ scripts/nip-accuracy.py on the slice (steady 4x64 and 8x128 at 2 mesh phases, a
   * the quasi-static figure is the mean over the run's second half, and every error
     in the CSV is |speed ratio - reference| with the reference (two meshes: the finer
     phase mean) stated in the report.
+
+scripts/steady-phases.py on the steady slice (2 phases): phase 0 is the scene's own
+mesh, phase 1 another, and phases.csv's mean is the two runs' mean; a scene without a
+fine sector is refused.
 """
 import csv
 import json
@@ -138,5 +142,29 @@ if len(rows) == 5:
     with open(os.path.join(out, "nip-accuracy.md")) as fh:
         T.check(f"Reference speed ratio {ref:.6f}: the finest phase mean" in fh.read(), "the report states the reference")
 T.check(os.path.getsize(os.path.join(out, "nip.png")) > 10000, "nip-accuracy's PNG written")
+
+# --- steady-phases.py ---------------------------------------------------------
+out = T.path("steady-phases")
+script("steady-phases.py", T.input("pinch-roller-slice-steady.xml"), "--phases", "2", "--out", out)
+with open(os.path.join(out, "phases.csv")) as fh:
+    ratio = next((r for r in csv.DictReader(fh) if r["step"] == "1" and r["figure"] == "core speed_ratio"), None)
+runs = []
+for j in range(2):
+    with open(os.path.join(out, f"p{j}", "summary.json")) as fh:
+        runs.append(json.load(fh)["steps"][0]["supports"]["core"]["speed_ratio"])
+_, own, _ = T.run_scene(T.input("pinch-roller-slice-steady.xml"), "phases-own", sets=["Output/Write Fields=false"])
+if ratio and own:
+    mine = own["steps"][0]["supports"]["core"]["speed_ratio"]
+    T.check(abs(runs[0] - mine) < 1e-12 and abs(runs[1] - mine) > 1e-5,
+            f"phase 0 is the scene's mesh ({runs[0]:.9f} against {mine:.9f}), phase 1 another ({runs[1]:.9f})")
+    T.check(abs(float(ratio["mean"]) - sum(runs) / 2) < 1e-12 and abs(float(ratio["spread"]) - abs(runs[1] - runs[0])) < 1e-12,
+            f"phases.csv: speed ratio mean {float(ratio['mean']):.9f}, spread {float(ratio['spread']):.2e}")
+else:
+    T.check(False, "phases.csv has the core's speed ratio, and the scene's own run a summary")
+p = subprocess.run([sys.executable, os.path.join(scripts, "steady-phases.py"), T.input("pinch-roller-slice-steady.xml"),
+                    "--capstan", T.capstan, "--out", T.path("phases-uniform"), "--set", "Mesh/Fine Sector={0, 0, 0}"],
+                   capture_output=True, text=True, timeout=60)
+T.check(p.returncode != 0 and "Fine Sector of positive width" in p.stderr,
+        f"a uniform mesh is refused: exit {p.returncode}, {p.stderr.strip()[-120:]}")
 
 T.finish()
