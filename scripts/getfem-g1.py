@@ -48,13 +48,14 @@ docs/performance.md "Against GetFEM".
 
 Usage (Debian: apt-get install -y python3-getfem; run with /usr/bin/python3):
   scripts/getfem-g1.py [--refine 1,2] [--rtol 1e-10] [--r 1000] [--check] [--blas-dir DIR]
-  scripts/getfem-g1.py --compare build/capstan [--refine 1,2] [--rounds 5]
+  scripts/getfem-g1.py --compare build/capstan [--refine 1,2] [--rounds 5] [--ranks 1]
       alternates fresh processes of this script (one refinement) and of
       `capstan run g1.xml --set Mesh/Cells=... --quiet` and prints the per-round times
       and the median GetFEM/capstan ratios. Both run with OMP_NUM_THREADS=1 (and the
       BLAS thread variables = 1). Two ratios are shown: solve = GetFEM's mesh->step 5
       wall vs capstan's summary.json timing.total; process = whole process wall time
       (python start + import getfem vs capstan start-up, Trilinos init and output files).
+      --ranks N runs capstan on N MPI ranks (mpiexec; the GetFEM run stays serial).
   --blas-dir DIR puts DIR first on LD_LIBRARY_PATH (of both codes with --compare), e.g.
       apt-get download libopenblas0-serial && dpkg -x libopenblas0-serial_*.deb ob
       --blas-dir ob/usr/lib/x86_64-linux-gnu/openblas-serial
@@ -226,11 +227,14 @@ def print_result(res):
                  s["residual0"], extra))
 
 
-def run_capstan(binary, scene, refine, outdir, args_blas_dir=None):
+def run_capstan(binary, scene, refine, outdir, args_blas_dir=None, ranks=1):
     cells = "{%d,%d,%d}" % tuple(refine * n for n in BASE_CELLS)
     cmd = [binary, "run", scene, "--output", outdir, "--set", "Mesh/Cells=" + cells, "--quiet"]
+    if ranks > 1:
+        cmd = ["mpiexec", "--oversubscribe", "-n", str(ranks)] + cmd
     t = time.perf_counter()
-    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, env=child_env(args_blas_dir))
+    env = dict(child_env(args_blas_dir), OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, env=env)
     wall = time.perf_counter() - t
     with open(os.path.join(outdir, "summary.json")) as f:
         s = json.load(f)
@@ -262,8 +266,8 @@ def compare(args, refines):
 
 
 def compare_in(args, refines, tmp):
-    print("capstan: %s; GetFEM: %s; Newton rtol %g; BLAS dir for both: %s; "
-          "OMP_NUM_THREADS=%s" % (args.compare, sys.executable, args.rtol,
+    print("capstan: %s on %d rank(s); GetFEM: %s; Newton rtol %g; BLAS dir for both: %s; "
+          "OMP_NUM_THREADS=%s" % (args.compare, args.ranks, sys.executable, args.rtol,
                                   args.blas_dir or "system default",
                                   os.environ.get("OMP_NUM_THREADS")), flush=True)
     for k in refines:
@@ -279,7 +283,7 @@ def compare_in(args, refines, tmp):
                 else:
                     row["cp_proc"], s = run_capstan(args.compare, args.scene, k,
                                                    os.path.join(tmp, "cap%dx" % k),
-                                                   args.blas_dir)
+                                                   args.blas_dir, args.ranks)
                     row["cp_total"] = s["timing"]["total"]
                     row["cp_sum"] = s
             rows.append(row)
@@ -319,6 +323,8 @@ def main():
     ap.add_argument("--compare", metavar="CAPSTAN_BINARY")
     ap.add_argument("--scene", default=DEFAULT_SCENE)
     ap.add_argument("--rounds", type=int, default=5)
+    ap.add_argument("--ranks", type=int, default=1,
+                    help="capstan's MPI ranks (mpiexec; GetFEM's Debian build is serial)")
     ap.add_argument("--blas-dir", metavar="DIR",
                     help="directory with a libblas.so.3/liblapack.so.3 put first on "
                          "LD_LIBRARY_PATH of both codes (e.g. an extracted "
