@@ -34,11 +34,11 @@ def command(capstan, scene, out, cells, ranks, sets=(), steps=0):
     return cmd
 
 
-def fine_cell(nt):
+def fine_cell(nt, sector=SECTOR):
     """(cells in the sector, fine cell angle in degrees) for nt circumferential cells, as
     AnnulusGenerator does it (std::lround, clamped to 1 .. nt-1)."""
-    m = min(max(int(SECTOR[2] * nt + 0.5), 1), nt - 1)
-    return m, SECTOR[1] / m
+    m = min(max(int(sector[2] * nt + 0.5), 1), nt - 1)
+    return m, sector[1] / m
 
 
 def run_scene(capstan, scene, out, sets=()):

@@ -5,7 +5,7 @@ quasi-static, on the 1 mm slice (docs/accuracy.md, "The pinch-roller nip").
     scripts/nip-accuracy.py [--capstan build/capstan] [--out out/nip-accuracy] [--torque 0]
         [--steady 4x64,8x128,16x256,32x512] [--phases 8]
         [--quasi-static 4x64:1,4x64:0.5,4x64:0.25,8x128:1,8x128:0.5,16x256:1] [--window 24]
-        [--set PATH=VALUE ...] [--png docs/img/accuracy-nip.png]
+        [--sector -65,60,0.6] [--set PATH=VALUE ...] [--png docs/img/accuracy-nip.png]
 
 Steady (inputs/pinch-roller-braked-steady.xml at brake torque --torque, 0 = the free
 roller): each mesh at --phases mesh phases, the mesh turned by j/phases of one fine cell
@@ -24,7 +24,8 @@ steady mesh's "worst phase" is the largest error over its phases, what one solve
 unluckily placed mesh gives. Wall times are the runs' own (summary.json timing.total);
 a phase mean costs the sum of its phases.
 
---set adds a scene setting to every run (e.g. the upwind order or a Tanh law, steady only
+--sector sets the steady meshes' fine sector (the quasi-static runs keep the scene's,
+which must cover the nip as the mesh rolls). --set adds a scene setting to every run (e.g. the upwind order or a Tanh law, steady only
 with --quasi-static ""). Writes OUT/nip-accuracy.csv (one row per run), OUT/nip-accuracy.md and the PNG. Runs
 whose summary.json exists under OUT are reused.
 """
@@ -58,11 +59,12 @@ def reuse_or_run(capstan, scene, out, sets):
 def steady_runs(a, mesh):
     """Rows of the steady runs of one mesh, one per phase."""
     nr, nt = cells_of(mesh)
-    _, cell = fine_cell(nt)
+    sector = a.sector
+    _, cell = fine_cell(nt, sector)
     rows = []
     for j in range(a.phases):
-        centre = SECTOR[0] - j / a.phases * cell
-        sets = [f"Mesh/Cells={{{nr}, {nt}, 1}}", "Mesh/Fine Sector={%.10g, %g, %g}" % (centre, SECTOR[1], SECTOR[2]),
+        centre = sector[0] - j / a.phases * cell
+        sets = [f"Mesh/Cells={{{nr}, {nt}, 1}}", "Mesh/Fine Sector={%.10g, %g, %g}" % (centre, sector[1], sector[2]),
                 f"Supports/core/Torque={a.torque:g}", "Supports/core/Torque Ramp Time=0.002", "Time/Steps=2"] + a.set
         rc, s = reuse_or_run(a.capstan, STEADY_SCENE, os.path.join(a.out, "steady", mesh, f"p{j}"), sets)
         ok = rc == 0 and s is not None and s["converged"]
@@ -108,9 +110,12 @@ def main():
     ap.add_argument("--phases", type=int, default=8)
     ap.add_argument("--quasi-static", dest="qs", default="4x64:1,4x64:0.5,4x64:0.25,8x128:1,8x128:0.5,16x256:1")
     ap.add_argument("--window", type=float, default=24.0, help="ms of rolling averaged (after as many from rest)")
+    ap.add_argument("--sector", default=",".join(f"{x:g}" for x in SECTOR),
+                    help="the steady meshes' Mesh/Fine Sector: centre, width (deg), fraction of the cells")
     ap.add_argument("--set", action="append", default=[], help="PATH=VALUE for every run")
     ap.add_argument("--png", default=os.path.join(ROOT, "docs", "img", "accuracy-nip.png"))
     a = ap.parse_args()
+    a.sector = tuple(float(x) for x in a.sector.split(","))
     meshes = [m.strip() for m in a.steady.split(",") if m.strip()]
     qs_cases = [(c.split(":")[0], float(c.split(":")[1])) for c in a.qs.split(",") if c.strip()]
 
