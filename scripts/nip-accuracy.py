@@ -27,15 +27,16 @@ a phase mean costs the sum of its phases.
 --sector sets the steady meshes' fine sector (the quasi-static runs keep the scene's,
 which must cover the nip as the mesh rolls). --set adds a scene setting to every run (e.g. the upwind order or a Tanh law, steady only
 with --quasi-static ""). Writes OUT/nip-accuracy.csv (one row per run), OUT/nip-accuracy.md and the PNG. Runs
-whose summary.json exists under OUT are reused.
+of the same scene and settings whose summary.json exists under OUT are reused.
 """
 import argparse
 import csv
+import json
 import math
 import os
 import sys
 
-from capstan_runs import ROOT, fine_cell, pyplot, run_scene, write_report, SECTOR
+from capstan_runs import ROOT, SECTOR, fine_cell, pyplot, run_scene, save_png, write_report
 
 STEADY_SCENE, QS_SCENE = "pinch-roller-braked-steady.xml", "pinch-roller-braked.xml"
 
@@ -46,13 +47,20 @@ def cells_of(mesh):
 
 
 def reuse_or_run(capstan, scene, out, sets):
-    """(exit status, summary or None): the summary under `out` if a run left one, else a run."""
-    path = os.path.join(out, "summary.json")
-    if os.path.isfile(path):
-        import json
-        with open(path) as fh:
-            return 0, json.load(fh)
+    """(exit status, summary or None): the summary a run of the same scene and settings
+    left under `out` (its settings.json says which), else a new run."""
+    path, settings = os.path.join(out, "summary.json"), os.path.join(out, "settings.json")
+    want = {"scene": scene, "sets": list(sets)}
+    if os.path.isfile(path) and os.path.isfile(settings):
+        with open(settings) as fh:
+            same = json.load(fh) == want
+        if same:
+            with open(path) as fh:
+                return 0, json.load(fh)
     rc, _, s = run_scene(capstan, scene, out, sets)
+    if s is not None:
+        with open(settings, "w") as fh:
+            json.dump(want, fh)
     return rc, s
 
 
@@ -196,9 +204,7 @@ def main():
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=8)
     fig.tight_layout()
-    os.makedirs(os.path.dirname(os.path.abspath(a.png)), exist_ok=True)
-    fig.savefig(a.png, dpi=130)
-    print(f"wrote {a.png}")
+    save_png(fig, a.png)
     return 1 if failed else 0
 
 

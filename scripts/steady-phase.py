@@ -22,7 +22,7 @@ import math
 import os
 import sys
 
-from capstan_runs import ROOT, SECTOR, fine_cell, pyplot, run_scene
+from capstan_runs import ROOT, SECTOR, fine_cell, pyplot, run_scene, save_png
 
 SCENE = "pinch-roller-braked-steady.xml"
 # Quasi-static reference: the mean speed ratio over the second half of a transient run of the
@@ -117,9 +117,7 @@ def main():
         ax.grid(alpha=0.3)
     fig.legend(*axes[0][0].get_legend_handles_labels(), loc="center right", fontsize=9)
     fig.tight_layout(rect=(0, 0, 1 - 0.9 / fig.get_figwidth(), 1))
-    os.makedirs(os.path.dirname(os.path.abspath(a.png)), exist_ok=True)
-    fig.savefig(a.png, dpi=150)
-    print(f"wrote {a.png}")
+    save_png(fig, a.png, dpi=150)
     return 1 if failed else 0
 
 
