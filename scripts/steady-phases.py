@@ -8,7 +8,7 @@ pinch-roller nip").
 
 The scene must be a steady one on an annulus with a `Mesh/Fine Sector` (its nip cells):
 phase j of K turns the mesh by j/K of one fine cell (the sector's centre moved by that
-much; phase 0 is the scene's own mesh). The runs go to OUT/pJ. For every step, and every free core and capstan, the mean, least and
+much; phase 0 is the scene's own mesh; an `Accuracy` preset's refined cells counted). The runs go to OUT/pJ. For every step, and every free core and capstan, the mean, least and
 largest value over the phases of the speed ratio, the core's angular velocity, the
 capstan's force magnitude and torque and its slip power are written to OUT/phases.csv
 and as a table to OUT/phases.md. The mean over the phases is what the quasi-static
@@ -22,7 +22,7 @@ import os
 import sys
 import xml.etree.ElementTree as ET
 
-from capstan_runs import ROOT, run_scene, write_report
+from capstan_runs import ROOT, fine_cell, run_scene, write_report
 
 
 def scene_value(scene, sets, path):
@@ -50,9 +50,10 @@ def phase_sets(scene, sets, phases):
     if sector is None or cells is None or numbers(sector)[1] <= 0:
         sys.exit(f"steady-phases.py: {scene}: needs Mesh/Cells and a Mesh/Fine Sector of positive width")
     centre, width, fraction = numbers(sector)
-    nt = int(numbers(cells)[1])
-    m = min(max(int(fraction * nt + 0.5), 1), nt - 1)  # as the annulus generator counts its fine cells
-    return [f"Mesh/Fine Sector={{{centre - j / phases * width / m:.10g}, {width:g}, {fraction:g}}}"
+    # Accuracy = Standard / Fine refine the scene's cells 2x / 4x (src/scene.cpp).
+    refine = {"Standard": 2, "Fine": 4}.get(scene_value(scene, sets, "Accuracy") or "Scene", 1)
+    _, cell = fine_cell(refine * int(numbers(cells)[1]), (centre, width, fraction))
+    return [f"Mesh/Fine Sector={{{centre - j / phases * cell:.10g}, {width:g}, {fraction:g}}}"
             for j in range(phases)]
 
 
