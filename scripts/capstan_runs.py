@@ -41,6 +41,13 @@ def fine_cell(nt, sector=SECTOR):
     return m, sector[1] / m
 
 
+def turned_sector(nt, turn, sector=SECTOR):
+    """The mesh turned by `turn` fine cells (a mesh phase): (the sector's centre, its
+    Mesh/Fine Sector setting) for nt circumferential cells."""
+    centre = sector[0] - turn * fine_cell(nt, sector)[1]
+    return centre, "Mesh/Fine Sector={%.10g, %g, %g}" % (centre, sector[1], sector[2])
+
+
 def run_scene(capstan, scene, out, sets=()):
     """One quiet `capstan run` of inputs/SCENE with no field output, timed:
     (exit status, wall seconds, summary.json or None)."""

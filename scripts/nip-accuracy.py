@@ -36,7 +36,7 @@ import math
 import os
 import sys
 
-from capstan_runs import ROOT, SECTOR, fine_cell, pyplot, run_scene, save_png, write_report
+from capstan_runs import ROOT, SECTOR, pyplot, run_scene, save_png, turned_sector, write_report
 
 STEADY_SCENE, QS_SCENE = "pinch-roller-braked-steady.xml", "pinch-roller-braked.xml"
 
@@ -67,12 +67,9 @@ def reuse_or_run(capstan, scene, out, sets):
 def steady_runs(a, mesh):
     """Rows of the steady runs of one mesh, one per phase."""
     nr, nt = cells_of(mesh)
-    sector = a.sector
-    _, cell = fine_cell(nt, sector)
     rows = []
     for j in range(a.phases):
-        centre = sector[0] - j / a.phases * cell
-        sets = [f"Mesh/Cells={{{nr}, {nt}, 1}}", "Mesh/Fine Sector={%.10g, %g, %g}" % (centre, sector[1], sector[2]),
+        sets = [f"Mesh/Cells={{{nr}, {nt}, 1}}", turned_sector(nt, j / a.phases, a.sector)[1],
                 f"Supports/core/Torque={a.torque:g}", "Supports/core/Torque Ramp Time=0.002", "Time/Steps=2"] + a.set
         rc, s = reuse_or_run(a.capstan, STEADY_SCENE, os.path.join(a.out, "steady", mesh, f"p{j}"), sets)
         ok = rc == 0 and s is not None and s["converged"]

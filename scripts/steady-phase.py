@@ -22,7 +22,7 @@ import math
 import os
 import sys
 
-from capstan_runs import ROOT, SECTOR, fine_cell, pyplot, run_scene, save_png
+from capstan_runs import ROOT, SECTOR, fine_cell, pyplot, run_scene, save_png, turned_sector
 
 SCENE = "pinch-roller-braked-steady.xml"
 # Quasi-static reference: the mean speed ratio over the second half of a transient run of the
@@ -34,11 +34,11 @@ QS = {"4x64": {0.0: 0.98961, 0.15: 0.98357, 0.3: 0.97809, 0.6: 0.96714, 1.0: 0.9
       "8x128": {0.0: 0.99125, 0.15: 0.98493, 0.3: 0.97713, 0.6: 0.96048, 1.0: 0.93190}}
 
 
-def steady(capstan, out, cells, torque, centre):
+def steady(capstan, out, cells, torque, sector):
     """One steady run at `torque` (two steps, the torque ramped over them): (exit status,
     speed ratio of the last step or nan, Newton iterations per step)."""
     sets = ["Mesh/Cells={%d, %d, 1}" % cells,
-            "Mesh/Fine Sector={%.10g, %g, %g}" % (centre, SECTOR[1], SECTOR[2]),
+            sector,
             f"Supports/core/Torque={torque:g}", "Supports/core/Torque Ramp Time=0.002",
             "Time/Steps=2"]
     stale = os.path.join(out, "summary.json")
@@ -72,9 +72,9 @@ def main():
               f"coarse cell {(360 - SECTOR[1]) / (cells[1] - m):.6f} deg", flush=True)
         for torque in torques:
             for j, ph in enumerate(phases):
-                centre = SECTOR[0] - ph * dtheta
+                centre, sector = turned_sector(cells[1], ph)
                 out = os.path.join(a.out, mesh, f"M{torque:g}", f"p{j}")
-                rc, ratio, newton = steady(a.capstan, out, cells, torque, centre)
+                rc, ratio, newton = steady(a.capstan, out, cells, torque, sector)
                 rows.append(dict(mesh=mesh, torque=torque, phase=ph, centre=centre,
                                  exit=rc, speed_ratio=ratio, newton=newton))
                 if rc != 0:

@@ -22,7 +22,7 @@ import os
 import sys
 import xml.etree.ElementTree as ET
 
-from capstan_runs import ROOT, fine_cell, run_scene, write_report
+from capstan_runs import ROOT, run_scene, turned_sector, write_report
 
 
 def scene_value(scene, sets, path):
@@ -52,9 +52,8 @@ def phase_sets(scene, sets, phases):
     centre, width, fraction = numbers(sector)
     # Accuracy = Standard / Fine refine the scene's cells 2x / 4x (src/scene.cpp).
     refine = {"Standard": 2, "Fine": 4}.get(scene_value(scene, sets, "Accuracy") or "Scene", 1)
-    _, cell = fine_cell(refine * int(numbers(cells)[1]), (centre, width, fraction))
-    return [f"Mesh/Fine Sector={{{centre - j / phases * cell:.10g}, {width:g}, {fraction:g}}}"
-            for j in range(phases)]
+    nt = refine * int(numbers(cells)[1])
+    return [turned_sector(nt, j / phases, (centre, width, fraction))[1] for j in range(phases)]
 
 
 def figures(step):
