@@ -1,7 +1,10 @@
 #include "outputs.hpp"
 
 #include <Teuchos_CommHelpers.hpp>
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/resource.h>
+#include <unistd.h>
 
 #include <fstream>
 #include <sstream>
@@ -58,7 +61,41 @@ void writeAtomically(const fs::path& path, const std::string& text) {
 }
 
 Outputs::Outputs(Model& model, Log& log, Clock::time_point start) : m_(model), log_(log), t0_(start) {}
-Outputs::~Outputs() = default;
+Outputs::~Outputs() {
+  if (lock_ < 0) return;
+  std::error_code ec;
+  fs::remove(dir_ / ".capstan-lock", ec);  // still held: no run can have taken it meanwhile
+  close(lock_);
+}
+
+namespace {
+// Takes `dir`'s lock: the descriptor, or -1 with `why` set. A second run into
+// the same directory would truncate the first one's fields.h5 (HDF5 opens it
+// before it finds the file locked) and interleave their nip.csv rows.
+int lockDirectory(const fs::path& dir, std::string& why) {
+  const fs::path path = dir / ".capstan-lock";
+  const int fd = open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd < 0) {
+    why = "cannot create " + path.string();
+    return -1;
+  }
+  if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    char pid[32] = {};
+    const ssize_t n = pread(fd, pid, sizeof pid - 1, 0);
+    std::string holder(pid, n > 0 ? size_t(n) : 0);
+    while (!holder.empty() && (holder.back() == '\n' || holder.back() == ' ')) holder.pop_back();
+    why = "another capstan run is writing there" + (holder.empty() ? std::string() : " (process " + holder + ")") +
+          ": wait for it to end, or choose another directory";
+    close(fd);
+    return -1;
+  }
+  const std::string pid = std::to_string(getpid()) + "\n";
+  if (ftruncate(fd, 0) != 0 || pwrite(fd, pid.data(), pid.size(), 0) < 0) {
+    // The pid only names the holder in another run's message; the lock holds without it.
+  }
+  return fd;
+}
+}  // namespace
 
 void Outputs::checkDirectory() {
   dir_ = m_.scene.outputDirectory;
@@ -75,6 +112,8 @@ void Outputs::checkDirectory() {
     } else {
       test.close();
       fs::remove(probe);
+      lock_ = lockDirectory(dir_, dirError);
+      dirOk = lock_ >= 0;
     }
   }
   Teuchos::broadcast(*m_.comm, 0, &dirOk);

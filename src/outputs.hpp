@@ -35,8 +35,10 @@ class Outputs {
   // start: when the run started (summary.json's total time counts from it).
   Outputs(Model& model, Log& log, std::chrono::steady_clock::time_point start);
   ~Outputs();
-  // Checks that Output/Directory can be written (InputError otherwise, before
-  // anything is written) and creates it.
+  // Checks that Output/Directory can be written and that no other run is
+  // writing there (InputError otherwise, before anything is written), creates
+  // it and holds its lock (.capstan-lock, an flock released when the process
+  // ends) for the run.
   void checkDirectory();
   const std::filesystem::path& directory() const { return dir_; }
   // Starts fields.h5 (a restart continues `restartDir`'s after step
@@ -66,6 +68,7 @@ class Outputs {
   std::unique_ptr<FieldWriter> writer_;
   std::unique_ptr<NipTable> nip_;
   double outputSeconds_ = 0;
+  int lock_ = -1;  // the output directory's lock file, held by rank 0
 };
 
 // Writes `text` to `path` through a temporary file and a rename: readers see

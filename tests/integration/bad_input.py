@@ -12,16 +12,22 @@ binary garbage, a missing scene file, an output directory under a regular file,
 bad NOX and Stratimikos sublists (MueLu's own parameters too, MUMPS' Precision), a mesh with fewer cells than ranks, and bad
 --set values.
 
+An output directory another run is writing to: exit 1, the message names the file,
+Output/Directory and the other run; the other run ends as it would have, its
+fields.h5 whole.
+
 Then the warning for a capstan that can never touch its contact faces: printed
 (naming the file and the capstan), the run goes on and exits 0; no warning for
 G1, nor for a capstan that starts far away but moves into the body.
 """
 import os
+import subprocess
 import sys
+import time
 
 sys.dont_write_bytecode = True
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from capstan_test import Test  # noqa: E402
+from capstan_test import Test, read_fields  # noqa: E402
 
 T = Test("bad_input", __doc__)
 G1 = open(T.input("seed/g1.xml")).read()
@@ -274,5 +280,33 @@ roller_case("core: unknown rotation", ["Supports/core/Rotation=Spinning"], "Supp
 roller_case("core: zero axis", ["Supports/core/Axis Direction={0, 0, 0}"], "Supports/core/Axis Direction")
 roller_case("core: negative contact smoothing", ["Capstans/capstan/Contact/Smoothing=-1"], "Capstans/capstan/Contact/Smoothing")
 roller_case("rigid-core parameter on a Roller", ["Supports/front/Torque=1"], "Supports/front/Torque")
+
+# --- an output directory in use by another run ------------------------------------------
+# A 10-step steady brake sweep (a few seconds) holds the directory; a second run into it
+# must stop before it touches anything (HDF5 would truncate the first run's fields.h5).
+busy = T.path("out", "busy")
+sweep = T.input("pinch-roller-steady.xml")
+first = subprocess.Popen(T.command(["run", sweep, "--output", busy, "--quiet", "--set", "Time/Steps=10",
+                                    "--set", "Supports/core/Torque=18",
+                                    "--set", "Supports/core/Torque Ramp Time=0.010"]),
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=work)
+lock = os.path.join(busy, ".capstan-lock")
+for _ in range(600):
+    if os.path.exists(os.path.join(busy, "fields.h5")) or first.poll() is not None:
+        break
+    time.sleep(0.02)
+second = T.capstan_run(["run", T.input("pinch-roller-slice-steady.xml"), "--output", busy, "--quiet"], cwd=work)
+running = first.poll() is None
+_, first_err = first.communicate(timeout=600)
+T.check(running, "the first run was still running when the second started (else the case tests nothing)")
+T.check(second.returncode == 1 and all(n in second.stderr for n in ("pinch-roller-slice-steady.xml", "Output/Directory",
+                                                                     f"another capstan run is writing there (process {first.pid})")),
+        f"a second run into a busy directory: exit {second.returncode}, {second.stderr.strip()[:300]}")
+T.check(first.returncode == 0, f"the first run ends as it would: exit {first.returncode}, {first_err.strip()[-300:]}")
+fields = os.path.join(busy, "fields.h5")
+steps = max(read_fields(fields)) if first.returncode == 0 and os.path.exists(fields) else None
+T.check(steps == 10, f"its fields.h5 holds its steps to 10 ({steps})")
+T.check(not os.path.exists(lock), "the lock file is gone once the run ends")
+T.check(listing(work) == {}, "the working directory stays empty")
 
 T.finish()
