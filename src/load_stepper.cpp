@@ -82,9 +82,14 @@ bool LoadStepper::advance(StepRecord& rec, std::string& failure) {
     const double rampLeft = steady ? loadRampLeft(assembly, tDone_) : 0;
     if (rampLeft > 0 && h >= rampLeft) h = rampLeft / 2;
     log_.progress(format("  step %d: cut back to dt = %.4g (%s)", rec.step, h, why.c_str()));
+    if (!chatterHinted_ && !stickChatterHint(m_.scene, why).empty()) {
+      chatterHinted_ = true;  // once a run: the hint, before the cuts' retries
+      log_.progress("  " + stickChatterHint(m_.scene, why).substr(2));
+    }
     if (h < minimumSubstep) {
       failure = "step " + std::to_string(rec.step) + " failed at minimum step size " +
-                Teuchos::toString(minimumSubstep) + ": " + why + brakeDiagnosis(m_.scene);
+                Teuchos::toString(minimumSubstep) + ": " + why + brakeDiagnosis(m_.scene) +
+                stickChatterHint(m_.scene, why);
       m_.restore(atStep);
       tDone_ = tStep;
       assembly.setInterval(tDone_, tDone_);

@@ -35,6 +35,7 @@ class LoadStepper {
   AugmentationLoop augmentation_;
   SteadyRolling steady_;  // Analysis/Type = Steady Rolling: each step a steady state
   double tDone_;
+  bool chatterHinted_ = false;  // the stick chatter hint printed (stickChatterHint)
 };
 
 }  // namespace capstan

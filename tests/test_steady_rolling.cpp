@@ -14,6 +14,7 @@
 #include "newton.hpp"
 #include "pressure_step_check.hpp"
 #include "roller_scene.hpp"
+#include "rolling.hpp"
 #include "scene.hpp"
 
 using namespace capstan;
@@ -179,6 +180,22 @@ TEST(SteadyScene, RejectsWhatItCannotSolve) {
   fails({"Supports/core/Axis Direction={0,1,1}"}, "Supports/core/Axis Direction");
   fails({"Analysis/Upwind Order=3"}, "Analysis/Upwind Order");
   fails({"Analysis/Type=Steady"}, "Analysis/Type");
+}
+
+// A steady state that stalled under Coulomb's exact stick is told what
+// converges where stick and slip chatter; other failures, other laws and the
+// quasi-static analysis are not.
+TEST(SteadyScene, StickChatterHint) {
+  const std::string stalled = "augmentation loop stalled: volume change at 6e+06 x its tolerance";
+  const Scene coulomb = steadyScene({"Capstans/capstan/Friction/Law=Coulomb"});
+  const std::string hint = stickChatterHint(coulomb, stalled);
+  EXPECT_NE(hint.find("Friction/Law = Tanh with Regularization 0.0005 "), std::string::npos) << hint;  // 1e-3 x 0.5 x 1
+  EXPECT_NE(hint.find("capstan 'capstan'"), std::string::npos) << hint;
+  EXPECT_EQ(stickChatterHint(coulomb, "newton failed (line search) in 60 iterations"), "");
+  EXPECT_EQ(stickChatterHint(steadyScene({}), stalled), "");  // Tanh
+  EXPECT_EQ(stickChatterHint(parseScene(test::kRollerScene, "roller.xml", {"Capstans/capstan/Friction/Law=Coulomb"}, ""),
+                             stalled),
+            "");
 }
 
 }  // namespace

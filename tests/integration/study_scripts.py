@@ -25,6 +25,9 @@ scripts/nip-accuracy.py on the slice (steady 4x64 and 8x128 at 2 mesh phases, a
 scripts/steady-phases.py on the steady slice (2 phases): phase 0 is the scene's own
 mesh, phase 1 another, and phases.csv's mean is the two runs' mean; a scene without a
 fine sector is refused.
+
+scripts/stick-shear.py on the steady slice at 8x256: one table row, stick faces counted, the
+shear's alternation a fraction of mu p_max (rms at most the largest).
 """
 import csv
 import json
@@ -166,5 +169,16 @@ p = subprocess.run([sys.executable, os.path.join(scripts, "steady-phases.py"), T
                    capture_output=True, text=True, timeout=60)
 T.check(p.returncode != 0 and "Fine Sector of positive width" in p.stderr,
         f"a uniform mesh is refused: exit {p.returncode}, {p.stderr.strip()[-120:]}")
+
+# --- stick-shear.py -------------------------------------------------------------
+T.run_scene(T.input("pinch-roller-slice-steady.xml"), "stick-shear", sets=["Mesh/Cells={8, 256, 1}"])
+p = subprocess.run([sys.executable, os.path.join(scripts, "stick-shear.py"), T.path("stick-shear")],
+                   capture_output=True, text=True, timeout=60)
+row = [line.split("|")[1:-1] for line in p.stdout.splitlines() if line.startswith("| " + T.path("stick-shear"))]
+if p.returncode == 0 and len(row) == 1 and " - " not in row[0]:
+    faces, rms, largest = int(row[0][1]), float(row[0][2]), float(row[0][3])
+    T.check(faces > 0 and 0 < rms <= largest < 1, f"stick-shear.py: {faces} stick faces, rms {rms}, largest {largest}")
+else:
+    T.check(False, f"stick-shear.py: exit {p.returncode}, {p.stdout[-300:]} {p.stderr[-300:]}")
 
 T.finish()
