@@ -9,9 +9,12 @@ Runs, one after the other on this machine:
   * with --transient, the quasi-static drive (inputs/pinch-roller.xml, its first STEPS
     steps, default 20: about 15 minutes on one core), for the time ratio.
 and prints, per run, the wall time, Newton iterations per step, cuts, speed ratios, and the
-ratio of the transient wall time to the steady one.
+ratio of the transient wall time to the steady one. --cells NR,NT,NZ runs the 3D drive's
+three runs on another mesh (the scenes' own fine sector), e.g. 3,160,8: twice the shipped
+mesh's circumferential and axial cells.
 
-  scripts/steady-bench.py [--capstan build/capstan] [--transient] [--steps 20] [--out out/steady-bench]
+  scripts/steady-bench.py [--capstan build/capstan] [--transient] [--steps 20] [--cells NR,NT,NZ]
+                          [--out out/steady-bench]
 """
 import argparse
 import os
@@ -39,18 +42,20 @@ def main():
     ap.add_argument("--transient", action="store_true", help="also run the quasi-static drive (minutes)")
     ap.add_argument("--steps", type=int, default=20, help="quasi-static steps (default 20)")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "steady-bench"))
+    ap.add_argument("--cells", help="NR,NT,NZ: the 3D drive's mesh (default the scenes' own)")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
-    rc, steady_wall, s = run_scene(a.capstan, "pinch-roller-steady.xml", os.path.join(a.out, "drive-steady"))
+    mesh = [f"Mesh/Cells={{{a.cells}}}"] if a.cells else []
+    rc, steady_wall, s = run_scene(a.capstan, "pinch-roller-steady.xml", os.path.join(a.out, "drive-steady"), mesh)
     describe("3D drive, steady state", rc, steady_wall, s)
     rc, wall, s = run_scene(a.capstan, "pinch-roller-steady.xml", os.path.join(a.out, "drive-sweep"),
-                      ["Supports/core/Torque=18", "Supports/core/Torque Ramp Time=0.010", "Time/Steps=10"])
+                      ["Supports/core/Torque=18", "Supports/core/Torque Ramp Time=0.010", "Time/Steps=10"] + mesh)
     describe("3D drive, 10-torque brake sweep", rc, wall, s)
     rc, wall, s = run_scene(a.capstan, "pinch-roller-braked-steady.xml", os.path.join(a.out, "slice-sweep"))
     describe("slice, 11-torque brake sweep", rc, wall, s)
     if a.transient:
         rc, wall, s = run_scene(a.capstan, "pinch-roller.xml", os.path.join(a.out, "drive-transient"),
-                          [f"Time/Steps={a.steps}"])
+                          [f"Time/Steps={a.steps}"] + mesh)
         describe(f"3D drive, quasi-static, {a.steps} steps", rc, wall, s)
         print(f"transient / steady wall time: {wall / steady_wall:.1f}")
     return 0

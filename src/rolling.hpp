@@ -21,10 +21,11 @@ double noSlipAngularVelocity(const Scene& scene, const RigidCore& core);
 // what friction in the nip can carry ("; support ...: ..."), or empty.
 std::string brakeDiagnosis(const Scene& scene);
 
-// What to try where a steady state under Coulomb's exact stick stalled
-// (failure: the attempt's reason): stick and slip can chatter from pass to
-// pass on a nip of many fine cells over a thick outer cell, where a Tanh law
-// or more radial cells converge (docs/steady-rolling.md, "Open"); or empty.
+// What to try where a rolling step (an annulus, steady or quasi-static) under
+// Coulomb's exact stick stalled (failure: the attempt's reason): stick and
+// slip can chatter from pass to pass on a nip of many fine cells over a thick
+// outer cell, where a Tanh law or more radial cells converge
+// (docs/steady-rolling.md, "Open"); or empty.
 std::string stickChatterHint(const Scene& scene, const std::string& failure);
 
 }  // namespace capstan
