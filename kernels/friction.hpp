@@ -89,12 +89,14 @@ struct FrictionPoint {
 // Kn (if not null, with K): the tangent with respect to xn, dR/dxn (12 x 12),
 // which steady rolling needs: there xn is the upstream nodes' position
 // (src/effects/steady_friction.cpp), an unknown like x.
+// slipHeld (if not null): per point, nonzero to take Coulomb's slip branch even
+// inside the cone (a point the multiplier loop found toggling; FrictionEffect::notePass).
 // Returns false (R, K untouched) if no point of the face is in contact.
 KOKKOS_INLINE_FUNCTION bool frictionFaceResidualTangent(
     const double X[4][3], const double x[4][3], const double xn[4][3], const Cylinder& cyl,
     double eps, double kappa, const double* lambda, FaceRule rule, const FrictionParameters& fp,
     const double* history, double R[12], double* K, FrictionPoint pts[kMaxFacePoints],
-    double* Kn = nullptr) {
+    double* Kn = nullptr, const int* slipHeld = nullptr) {
   const int nq = facePointCount(rule);
   bool touching = false;
   for (int q = 0; q < nq && !touching; ++q) {
@@ -202,7 +204,7 @@ KOKKOS_INLINE_FUNCTION bool frictionFaceResidualTangent(
             Tn[i][j] = Trn[i][j] / m - tr[i] / (m * m) * dm * dSn[j];
           }
         }
-      } else if (mag <= fp.mu * tn || fp.stickPredictor) {  // stick
+      } else if ((mag <= fp.mu * tn && !(slipHeld && slipHeld[q] && mag > 0)) || fp.stickPredictor) {  // stick
         p.state = 1;
         for (int i = 0; i < 3; ++i) {
           t[i] = tr[i];

@@ -90,6 +90,10 @@ class AugmentationLoop {
   // With the saddle-point step: whether the worst constraint has not come
   // below its best for kStallPasses passes (failure set).
   bool stalled(int it, const Constraints& c, std::string& failure);
+  // After a pass's Newton solve: friction points cycling between stick and
+  // slip held in slip (FrictionEffect::notePass); true where more are held now.
+  bool holdCyclingSlips(int it);
+  long heldSlips_ = 0;
   double bestWorst_ = 0;
   int bestPass_ = 0;
   // The pass's Newton solve on the positions (none for a step alone), with

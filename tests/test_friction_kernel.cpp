@@ -4,6 +4,7 @@
 // finite at zero slip; the traction never exceeds mu t_n.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <string>
@@ -42,15 +43,16 @@ struct Case {
   double history;      // Coulomb: magnitude of last step's traction
   int expectState;     // every point: 1 stick, 2 slip (0: do not check)
   double smoothing = 0;  // Coulomb: the smoothed stick/slip corner's width
+  bool held = false;     // Coulomb: every point held in slip (FrictionEffect::notePass)
 };
 
 std::vector<double> residual(const double X[4][3], const double x[4][3], const double xn[4][3],
                              const Cylinder& c, const FrictionParameters& fp, const double* lambda,
-                             const double* h) {
+                             const double* h, const int* held = nullptr) {
   std::vector<double> R(12, 0.0);
   FrictionPoint pts[kMaxFacePoints];
   if (!frictionFaceResidualTangent(X, x, xn, c, 1e-2, 1e-2, lambda, FaceRule::Gauss2, fp, h, R.data(),
-                                   nullptr, pts))
+                                   nullptr, pts, nullptr, held))
     std::fill(R.begin(), R.end(), 0.0);
   return R;
 }
@@ -69,6 +71,9 @@ TEST_P(FrictionTangent, MatchesCentralDifferences) {
   fp.spin = k.spin;
   fp.smoothing = k.smoothing;
   double lambda[kMaxFacePoints] = {}, h[3 * kMaxFacePoints];
+  int heldAll[kMaxFacePoints];
+  std::fill(heldAll, heldAll + kMaxFacePoints, 1);
+  const int* held = k.held ? heldAll : nullptr;
   for (int q = 0; q < kMaxFacePoints; ++q) {
     h[3 * q] = k.history * (1 + 0.1 * q);
     h[3 * q + 1] = 0.2 * k.history;
@@ -83,7 +88,7 @@ TEST_P(FrictionTangent, MatchesCentralDifferences) {
     std::vector<double> R(12), K(144), Kn(144);
     FrictionPoint pts[kMaxFacePoints];
     ASSERT_TRUE(frictionFaceResidualTangent(X, x, xn, cyl, 1e-2, 1e-2, lambda, FaceRule::Gauss2, fp, h,
-                                            R.data(), K.data(), pts, Kn.data()))
+                                            R.data(), K.data(), pts, Kn.data(), held))
         << k.name << ": face not in contact at position " << pos;
     bool nearSwitch = false;
     for (int q = 0; q < 4; ++q) {
@@ -95,6 +100,7 @@ TEST_P(FrictionTangent, MatchesCentralDifferences) {
       if (k.expectState) {
         EXPECT_EQ(pts[q].state, k.expectState) << k.name << " point " << q;
       }
+      if (k.held) EXPECT_NEAR(tmag, k.mu * pts[q].normal, 1e-12 * k.mu * pts[q].normal) << k.name << ": at the cone";
       // Coulomb: central differences must not straddle the stick/slip switch.
       if (k.law == FrictionLaw::Coulomb && pts[q].state == 1)
         nearSwitch = nearSwitch || tmag > k.mu * pts[q].normal * (1 - 1e-4);
@@ -108,9 +114,9 @@ TEST_P(FrictionTangent, MatchesCentralDifferences) {
       scale = 0;
       for (int col = 0; col < 12; ++col) {
         y[col / 3][col % 3] += hx;
-        const auto Rp = residual(X, x, xn, cyl, fp, lambda, h);
+        const auto Rp = residual(X, x, xn, cyl, fp, lambda, h, held);
         y[col / 3][col % 3] -= 2 * hx;
-        const auto Rm = residual(X, x, xn, cyl, fp, lambda, h);
+        const auto Rm = residual(X, x, xn, cyl, fp, lambda, h, held);
         y[col / 3][col % 3] += hx;
         for (int row = 0; row < 12; ++row) {
           const double fd = (Rp[row] - Rm[row]) / (2 * hx);
@@ -145,7 +151,10 @@ INSTANTIATE_TEST_SUITE_P(
         Case{"coulomb slip, rolling", FrictionLaw::Coulomb, 0.1, 0, 1e-3, {0, 0, 0}, 0.05, {0, 0, 1}, 0.05, 2},
         Case{"coulomb slip, translating, skewed", FrictionLaw::Coulomb, 0.2, 0, 1e-3, {0.03, 0, 0.02}, 0, {0.2, 0.1, 1}, 0.1, 2},
         Case{"coulomb stick, skewed, history", FrictionLaw::Coulomb, 10.0, 0, 0.05, {0.001, 0, 0}, 0.002, {0.1, -0.2, 1}, 0.2, 1},
-        Case{"coulomb, smoothed corner", FrictionLaw::Coulomb, 0.3, 0, 1e-2, {0, 0, 0}, 0.01, {0, 0, 1}, 0.05, 0, 0.3}));
+        Case{"coulomb, smoothed corner", FrictionLaw::Coulomb, 0.3, 0, 1e-2, {0, 0, 0}, 0.01, {0, 0, 1}, 0.05, 0, 0.3},
+        // The stick case's points held in slip: the slip branch inside the cone.
+        Case{"coulomb stick held in slip", FrictionLaw::Coulomb, 5.0, 0, 0.1, {0, 0, 0}, 0.01, {0, 0, 1}, 0.05, 2, 0,
+             true}));
 
 // psi = phi(s)/s and chi = psi'(s)/s against finite differences of phi(s)/s,
 // across the series/closed-form switch, and finite at s = 0.

@@ -31,6 +31,7 @@ FrictionEffect::FrictionEffect(const std::string& name, const Mesh& mesh,
   history_ = Kokkos::View<double*>("friction history", nf * kHistoryPerFace);
   tangentialMultipliers_ = Kokkos::View<double*>("friction lambda_T", nf * kernels::kMaxFacePoints * 3);
   points_ = decltype(points_)("friction points", nf, kernels::kMaxFacePoints);
+  slipHeld_ = Kokkos::View<int*>("friction slip held", nf * kernels::kMaxFacePoints);
   local_.dofs = dofsOf(nodes_);
   local_.R = Matrix("friction R", nf, 12);
   local_.stiff = true;
@@ -81,6 +82,7 @@ void FrictionEffect::launch(const NodalVectors& x, const NodalVectors&, bool tan
   auto lambda = contact_.normalMultipliers();
   auto h = history_;
   auto lambdaT = tangentialMultipliers_;
+  auto held = slipHeld_;
   const bool useMultipliers = augmented();
   auto pts = points_;
   const kernels::Cylinder cyl = contact_.cylinder();
@@ -102,7 +104,7 @@ void FrictionEffect::launch(const NodalVectors& x, const NodalVectors&, bool tan
         active(f) = kernels::frictionFaceResidualTangent(
             Xf, xf, xn, cyl, eps, kappa, &lambda(f * kernels::kMaxFacePoints), rule, fp,
             useMultipliers ? &lambdaT(f * kernels::kMaxFacePoints * 3) : &h(f * kHistoryPerFace + 12),
-            &R(f, 0), tangent ? K : nullptr, p);
+            &R(f, 0), tangent ? K : nullptr, p, nullptr, &held(f * kernels::kMaxFacePoints));
         if (tangent && active(f)) sink.take<12>(f, K);
         for (int q = 0; q < kernels::facePointCount(rule); ++q) {
           for (int i = 0; i < 3; ++i) pts(f, q, kTraction + i) = p[q].traction[i];
@@ -144,6 +146,37 @@ void FrictionEffect::multiplierMap(const Kokkos::View<double*>& next) const {
         for (int q = 0; q < nq; ++q)
           for (int i = 0; i < 3; ++i) next((f * kernels::kMaxFacePoints + q) * 3 + i) = pts(f, q, kTraction + i);
       });
+}
+
+long FrictionEffect::notePass(bool mayHold) {
+  if (!stepsForItself()) return 0;
+  auto pts = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), points_);
+  const size_t nf = pts.extent(0);
+  const int nq = kernels::facePointCount(contact_.rule());
+  stateHistory_.resize(nf * kernels::kMaxFacePoints, {-1, -1, -1, 0});
+  std::vector<size_t> newlyHeld;
+  for (size_t f = 0; f < nf; ++f)
+    for (int q = 0; q < nq; ++q) {
+      auto& h = stateHistory_[f * kernels::kMaxFacePoints + q];  // {k-2, k-1, toggles, held}
+      const int now = int(pts(f, q, kState));
+      if (now != 0 && now != h[1] && now == h[0]) {
+        if (++h[2] >= 2 && mayHold && !h[3]) h[3] = 1, newlyHeld.push_back(f * kernels::kMaxFacePoints + q);
+      }
+      h[0] = h[1], h[1] = now;
+    }
+  if (newlyHeld.empty()) return held_;
+  auto held = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), slipHeld_);
+  for (size_t k : newlyHeld) held(k) = 1;
+  Kokkos::deep_copy(slipHeld_, held);
+  held_ += long(newlyHeld.size());
+  return held_;
+}
+
+void FrictionEffect::releaseHeldSlips() {
+  stateHistory_.clear();
+  if (held_ == 0) return;
+  Kokkos::deep_copy(slipHeld_, 0);
+  held_ = 0;
 }
 
 void FrictionEffect::stickRows(ConstraintRows& rows, int width, const StickRowFill& fill, std::vector<double>& grad,

@@ -67,6 +67,14 @@ class FrictionEffect : public Effect {
   bool stepsForItself() const override {
     return augmented() && parameters_.smoothing == 0 && contact_.rule() == kernels::FaceRule::Nodal;
   }
+  // Coulomb with the stick rows: after each pass's Newton solve, a point whose
+  // stick/slip state has gone A, B, A, B over four passes (the multiplier loop
+  // cycling at the stick zone's edge, where |t| = mu t_n to within the step's
+  // reach) is held in slip, at the cone, for the rest of the solve, where the
+  // loop has stopped making progress (mayHold); released at the next solve.
+  // Returns the points held so far.
+  long notePass(bool mayHold);
+  void releaseHeldSlips();
   double constraintViolation() const override;
   double constraintTolerance() const override { return contact_.constraintTolerance(); }
   std::string constraintName() const override { return name() + " stick slip"; }
@@ -107,6 +115,9 @@ class FrictionEffect : public Effect {
   // [face][12 + 3q + i]: Coulomb's traction at point q from that state.
   Kokkos::View<double*> history_;
   Kokkos::View<double*> tangentialMultipliers_;  // [(face * kMaxFacePoints + q) * 3 + i]
+  Kokkos::View<int*> slipHeld_;                  // [face * kMaxFacePoints + q]: notePass
+  std::vector<std::array<int, 4>> stateHistory_;  // per point: the last 3 passes' states, toggles
+  long held_ = 0;
   static constexpr int kHistoryPerFace = 12 + 3 * kernels::kMaxFacePoints;
   // Coulomb's sticking points, two rows each (constraintRows): the value,
   // multiplier, force, Schur diagonal and direction of each row into rows;

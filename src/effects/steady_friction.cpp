@@ -168,6 +168,7 @@ void SteadyFrictionEffect::launch(const NodalVectors& x, const NodalVectors&, bo
   auto active = local_.active;
   auto lambda = contact_.normalMultipliers();
   auto lambdaT = tangentialMultipliers_;
+  auto held = slipHeld_;
   auto h = history_;
   const bool useMultipliers = augmented();
   auto pts = points_;
@@ -210,7 +211,8 @@ void SteadyFrictionEffect::launch(const NodalVectors& x, const NodalVectors&, bo
                                    Xf, xf, xn, cyl, eps, kappa, &lambda(f * kernels::kMaxFacePoints), rule, fq,
                                    useMultipliers ? &lambdaT(f * kernels::kMaxFacePoints * 3)
                                                   : &h(f * kHistoryPerFace + 12),
-                                   &R(f, 0), tangent ? K : nullptr, p, tangent ? Kn : nullptr);
+                                   &R(f, 0), tangent ? K : nullptr, p, tangent ? Kn : nullptr,
+                                   &held(f * kernels::kMaxFacePoints));
         if (!active(f)) {
           for (int k = 0; k < 12; ++k) R(f, k) = 0;
         } else if (tangent) {
