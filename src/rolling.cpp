@@ -43,17 +43,15 @@ std::string stickChatterHint(const Scene& scene, const std::string& failure) {
     return "";
   for (const auto& c : scene.capstans) {
     if (c.friction.law != FrictionSettings::Law::Coulomb || !c.friction.grips()) continue;
-    // The steady 3D drive with 3 radial cells: 0.30-degree nip cells converge,
-    // 0.28 and finer do not; with 4-6 radial cells 0.10-0.21 degrees converge;
-    // Tanh at 1e-3 of the surface speed converges on the 0.21-degree nip in 39
-    // Newton iterations. The quasi-static drive stalls on that nip too, and
-    // converges with 4 radial cells (docs/steady-rolling.md, "Open").
+    // Points cycling between stick and slip are held in slip (docs/friction.md,
+    // item 11); where the loop still stalls, these converged on the meshes
+    // measured (docs/steady-rolling.md, "Stick and slip that cycle").
     const double speed = std::fabs(c.angularVelocity * c.radius);
     return "; capstan '" + c.name + "': Coulomb's stick and slip may not settle on this mesh (with --log newton, " +
-           "the pressure step's contact and stick rows change from pass to pass): on the 3D drive, steady and " +
-           "quasi-static, a nip of many fine cells over an outer radial cell thicker than the contact's " +
-           "half-width fails so, and more radial cells under the nip or Friction/Law = Tanh with Regularization " +
-           brief(1e-3 * speed) + " (1e-3 x the capstan's surface speed) converge (docs/steady-rolling.md, \"Open\")";
+           "the pressure step's contact and stick rows change from pass to pass): a nip of many fine cells over " +
+           "an outer radial cell thicker than the contact's half-width makes them chatter; more radial cells " +
+           "under the nip, or Friction/Law = Tanh with Regularization " + brief(1e-3 * speed) +
+           " (1e-3 x the capstan's surface speed), converge (docs/steady-rolling.md, \"Stick and slip that cycle\")";
   }
   return "";
 }

@@ -25,7 +25,7 @@ std::string brakeDiagnosis(const Scene& scene);
 // Coulomb's exact stick stalled (failure: the attempt's reason): stick and
 // slip can chatter from pass to pass on a nip of many fine cells over a thick
 // outer cell, where a Tanh law or more radial cells converge
-// (docs/steady-rolling.md, "Open"); or empty.
+// (docs/steady-rolling.md, "Stick and slip that cycle"); or empty.
 std::string stickChatterHint(const Scene& scene, const std::string& failure);
 
 }  // namespace capstan

@@ -34,7 +34,16 @@ first order).
     through a stage halfway to it (SteadyRolling::startThroughWideLaws; 868 Newton
     iterations and 3 cuts before, 988 before that), against the force ramped over two steps,
     whose second step goes through the wider laws again (SteadyRolling::solve).
+
+Then the steady 3D drive with a fine nip over thick outer cells (3x120x8, 0.28-degree nip
+cells on 3 radial cells, the sector centred on the nip), where Coulomb's stick and slip
+cycle from pass to pass at the stick zone's edge (before the hold it never converged):
+it converges with points held in slip (the log's held_slips events), in at most 120
+Newton iterations, no NaN, |t_f| <= mu t_n everywhere, volumes and contact within
+tolerance, and 2 ranks give the 1-rank speed ratio and capstan force to 3e-5 (the held
+points follow each run's round-off; Coulomb's path level is 2.3e-5).
 """
+import json
 import os
 import sys
 
@@ -119,4 +128,40 @@ for i, (name, scene, sets, ref_sets, pen_tol, budget, *rest) in enumerate(CASES)
     if "speed_ratio" in core:
         T.check(abs(core["speed_ratio"] - ref_core["speed_ratio"]) <= 2e-5,
                 f"{name}: speed ratio {core['speed_ratio']:.6f} against {ref_core['speed_ratio']:.6f} (2e-5)")
+
+# --- stick and slip that cycle: points held in slip ----------------------------------
+FINE_NIP = ["Mesh/Cells={3, 120, 8}", "Mesh/Fine Sector={-90, 20, 0.6}", NOFIELDS]
+runs = {}
+for ranks in (1, 2):
+    p, s, out = T.run_scene(T.input("pinch-roller-steady.xml"), f"fine-nip-{ranks}r", sets=FINE_NIP, ranks=ranks,
+                            extra=["--log", "newton"])
+    runs[ranks] = s
+    if s is None:
+        continue
+    held = 0
+    with open(os.path.join(out, "log.jsonl")) as fh:
+        for line in fh:
+            event = json.loads(line)
+            if event.get("event") == "held_slips":
+                held = max(held, int(event["points"]))
+    st = s["steps"][-1]
+    cap = st["capstans"]["capstan"]
+    T.check(s["converged"] and held > 0, f"fine nip, {ranks} rank(s): converged {s['converged']} with {held} points "
+            f"held in slip")
+    T.check(st["newton_iterations"] <= 120, f"fine nip, {ranks} rank(s): {st['newton_iterations']} Newton iterations "
+            f"(<= 120)")
+    T.check(not has_nan(s) and cap["friction"]["max_traction_ratio"] <= 1 + 1e-9 and
+            st["max_abs_volume_change"] < 1e-8 and cap["max_penetration"] <= 5e-5,
+            f"fine nip, {ranks} rank(s): no NaN, |t_f| / mu t_n {cap['friction']['max_traction_ratio']:.12f}, "
+            f"volume {st['max_abs_volume_change']:.1e}, penetration {cap['max_penetration']:.1e}")
+if runs.get(1) and runs.get(2):
+    a, b = runs[1]["steps"][-1], runs[2]["steps"][-1]
+    dr = abs(a["supports"]["core"]["speed_ratio"] - b["supports"]["core"]["speed_ratio"])
+    Fa, Fb = a["capstans"]["capstan"]["force"], b["capstans"]["capstan"]["force"]
+    dF = max(abs(x - y) for x, y in zip(Fa, Fb)) / max(abs(x) for x in Fa)
+    # Which points cycle, and so which are held, follows each run's own round-off (2 ranks
+    # held 52 points where 1 held 44, 9.7e-6 apart): the held points sit at the cone, where
+    # Coulomb's answer depends on the path to its tolerance's level (2.3e-5,
+    # docs/steady-rolling.md), not to 1e-8 as where nothing is held.
+    T.check(dr <= 3e-5 and dF <= 3e-5, f"fine nip: 2 ranks against 1, speed ratio {dr:.1e}, force {dF:.1e} (3e-5)")
 T.finish()
