@@ -82,9 +82,10 @@ bool LoadStepper::advance(StepRecord& rec, std::string& failure) {
     const double rampLeft = steady ? loadRampLeft(assembly, tDone_) : 0;
     if (rampLeft > 0 && h >= rampLeft) h = rampLeft / 2;
     log_.progress(format("  step %d: cut back to dt = %.4g (%s)", rec.step, h, why.c_str()));
-    if (!chatterHinted_ && !stickChatterHint(m_.scene, why).empty()) {
+    const std::string hint = chatterHinted_ ? std::string() : stickChatterHint(m_.scene, why);
+    if (!hint.empty()) {
       chatterHinted_ = true;  // once a run: the hint, before the cuts' retries
-      log_.progress("  " + stickChatterHint(m_.scene, why).substr(2));
+      log_.progress("  " + hint.substr(2));
     }
     if (h < minimumSubstep) {
       failure = "step " + std::to_string(rec.step) + " failed at minimum step size " +
