@@ -1,5 +1,7 @@
 #include "augmentation.hpp"
 
+#include "errors.hpp"
+
 #include <Teuchos_CommHelpers.hpp>
 
 #include <chrono>
@@ -161,7 +163,7 @@ bool AugmentationLoop::holdCyclingSlips(int it) {
 bool AugmentationLoop::stalled(int it, const Constraints& c, std::string& failure) {
   if (it == 1 || c.worst < bestWorst_) bestWorst_ = c.worst, bestPass_ = it;
   if (!m_.pressureStep || it - bestPass_ < kStallPasses) return false;
-  failure = format("augmentation loop stalled: %s at %.3g x its tolerance, not below pass %d's %.3g x in %d passes",
+  failure = format("%s: %s at %.3g x its tolerance, not below pass %d's %.3g x in %d passes", kStalledLoop,
                    c.worstName.c_str(), c.worst, bestPass_, bestWorst_, kStallPasses);
   return true;
 }

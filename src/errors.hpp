@@ -12,6 +12,10 @@ struct InputError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// How a failure reason starts where the multiplier loop stalled
+// (AugmentationLoop::stalled); stickChatterHint looks for it.
+inline constexpr const char* kStalledLoop = "augmentation loop stalled";
+
 // The part of a Trilinos exception text a user needs: Teuchos texts start with
 // the throwing source file and line, the throw count and the failed test.
 inline std::string trilinosMessage(const std::string& what) {

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "assembly.hpp"
+#include "errors.hpp"
 #include "parameters.hpp"
 #include "vec3.hpp"
 
@@ -39,7 +40,7 @@ std::string brakeDiagnosis(const Scene& scene) {
 }
 
 std::string stickChatterHint(const Scene& scene, const std::string& failure) {
-  if (scene.mesh.type != MeshSpec::Type::Annulus || failure.find("augmentation loop stalled") == std::string::npos)
+  if (scene.mesh.type != MeshSpec::Type::Annulus || failure.find(kStalledLoop) == std::string::npos)
     return "";
   for (const auto& c : scene.capstans) {
     if (c.friction.law != FrictionSettings::Law::Coulomb || !c.friction.grips()) continue;

@@ -153,16 +153,17 @@ long FrictionEffect::notePass(bool mayHold) {
   auto pts = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), points_);
   const size_t nf = pts.extent(0);
   const int nq = kernels::facePointCount(contact_.rule());
-  stateHistory_.resize(nf * kernels::kMaxFacePoints, {-1, -1, -1, 0});
+  cycles_.resize(nf * kernels::kMaxFacePoints);
   std::vector<size_t> newlyHeld;
   for (size_t f = 0; f < nf; ++f)
     for (int q = 0; q < nq; ++q) {
-      auto& h = stateHistory_[f * kernels::kMaxFacePoints + q];  // {k-2, k-1, toggles, held}
+      const size_t k = f * kernels::kMaxFacePoints + q;
+      auto& c = cycles_[k];
       const int now = int(pts(f, q, kState));
-      if (now != 0 && now != h[1] && now == h[0]) {
-        if (++h[2] >= 2 && mayHold && !h[3]) h[3] = 1, newlyHeld.push_back(f * kernels::kMaxFacePoints + q);
-      }
-      h[0] = h[1], h[1] = now;
+      // A, B, A: one return; A, B, A, B, A: three, a cycle.
+      if (now != 0 && now != c.last && now == c.beforeLast && ++c.returns >= 3 && mayHold && !c.held)
+        c.held = true, newlyHeld.push_back(k);
+      c.beforeLast = c.last, c.last = now;
     }
   if (newlyHeld.empty()) return held_;
   auto held = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), slipHeld_);
@@ -173,7 +174,7 @@ long FrictionEffect::notePass(bool mayHold) {
 }
 
 void FrictionEffect::releaseHeldSlips() {
-  stateHistory_.clear();
+  cycles_.clear();
   if (held_ == 0) return;
   Kokkos::deep_copy(slipHeld_, 0);
   held_ = 0;

@@ -68,7 +68,7 @@ class FrictionEffect : public Effect {
     return augmented() && parameters_.smoothing == 0 && contact_.rule() == kernels::FaceRule::Nodal;
   }
   // Coulomb with the stick rows: after each pass's Newton solve, a point whose
-  // stick/slip state has gone A, B, A, B over four passes (the multiplier loop
+  // stick/slip state has gone A, B, A, B, A over five passes (the multiplier loop
   // cycling at the stick zone's edge, where |t| = mu t_n to within the step's
   // reach) is held in slip, at the cone, for the rest of the solve, where the
   // loop has stopped making progress (mayHold); released at the next solve.
@@ -116,7 +116,13 @@ class FrictionEffect : public Effect {
   Kokkos::View<double*> history_;
   Kokkos::View<double*> tangentialMultipliers_;  // [(face * kMaxFacePoints + q) * 3 + i]
   Kokkos::View<int*> slipHeld_;                  // [face * kMaxFacePoints + q]: notePass
-  std::vector<std::array<int, 4>> stateHistory_;  // per point: the last 3 passes' states, toggles
+  struct PointCycle {     // one point's stick/slip states over the passes (notePass)
+    int beforeLast = -1;  // two passes ago
+    int last = -1;        // the last pass
+    int returns = 0;      // passes back to the state of two passes before
+    bool held = false;
+  };
+  std::vector<PointCycle> cycles_;  // [face * kMaxFacePoints + q]
   long held_ = 0;
   static constexpr int kHistoryPerFace = 12 + 3 * kernels::kMaxFacePoints;
   // Coulomb's sticking points, two rows each (constraintRows): the value,
