@@ -103,6 +103,23 @@ struct MumpsSolver::Impl {
   // with nonzeroPattern those nonzero since the pattern was new, and the
   // diagonal. a, irn and jcn hold the kept entries only, in the same order.
   std::vector<char> keep;
+  // symmetricPart: the pattern's entries above the diagonal (by global ids),
+  // never read; for those below, the flat index of the transpose entry on
+  // this rank (kNoMirror if its row is another rank's), and the values of
+  // this rank's rows in pattern order.
+  static constexpr std::size_t kNoMirror = std::size_t(-1);
+  std::vector<char> upper;
+  std::vector<std::size_t> mirror;
+  std::vector<double> rowValues;
+  // The mirrors in other ranks' rows: asked of their owners (askCounts,
+  // askOffsets per rank; mirrorsIn of them arrive at rowValues' end);
+  // ours that they asked for (mirrorsAsked, indices into rowValues, sent as
+  // mirrorsOut; askedCounts, askedOffsets per rank).
+  std::vector<int> askCounts, askOffsets, askedCounts, askedOffsets;
+  std::vector<std::size_t> mirrorsAsked;
+  std::size_t mirrorsIn = 0;
+  std::vector<std::pair<GO, std::size_t>> byColumn;  // findMirrors' scratch
+  std::vector<double> mirrorsOut;
 
   // What MUMPS reads: 1-based global row / column numbers and the values.
   // Rows are numbered rank by rank in local order (rank r's rows are
@@ -143,7 +160,7 @@ void MumpsSolver::initialize(const Teuchos::Comm<int>& comm, bool hostOnly) {
   impl->with([&](auto& id) {
     id.comm_fortran = fortranComm;  // MUMPS is Fortran inside
     id.par = 1;  // the host (rank 0) works too
-    id.sym = 0;  // unsymmetric: friction
+    id.sym = options_.symmetricPart ? 2 : 0;  // unsymmetric (friction), or A's symmetric part
   });
   impl_ = std::move(impl);  // from here on the destructor frees what there is
   run(-1);
@@ -186,7 +203,7 @@ bool MumpsSolver::extractPattern(const CrsMatrix& A) {
     // only add entries, so equal row lengths mean the same pattern.
     bool same = true;
     for (LO r = 0; r < nRows && same; ++r) same = A.getNumEntriesInLocalRow(r) == m.rowPtr[r + 1] - m.rowPtr[r];
-    if (same) return keepNonzeros(A, false);
+    if (same) return keepNonzeros(A, false, options_.symmetricPart && anyRank(false, m.comm));
   }
   m.graph = graph;
   const auto& rowMap = *A.getRowMap();
@@ -209,13 +226,14 @@ bool MumpsSolver::extractPattern(const CrsMatrix& A) {
     std::swap(m.newRowPtr, m.rowPtr);
     std::swap(m.newColGid, m.colGid);
   }
-  const bool grew = keepNonzeros(A, changed);
+  const bool grew = keepNonzeros(A, changed, options_.symmetricPart && anyRank(changed, m.comm));
   return changed || grew;
 }
 
 // Copies the kept entries' values into a; a nonzero outside the kept ones
-// joins them (returns true). fresh: the pattern is new, so is the set kept.
-bool MumpsSolver::keepNonzeros(const CrsMatrix& A, bool fresh) {
+// joins them (returns true). fresh: this rank's pattern is new, so is the set
+// kept; newMirrors (symmetricPart; collective): some rank's pattern is new.
+bool MumpsSolver::keepNonzeros(const CrsMatrix& A, bool fresh, bool newMirrors) {
   Impl& m = *impl_;
   bool grew = false;
   const LO nRows = static_cast<LO>(A.getNodeNumRows());
@@ -224,21 +242,126 @@ bool MumpsSolver::keepNonzeros(const CrsMatrix& A, bool fresh) {
     for (LO r = 0; r < nRows; ++r)
       for (std::size_t k = m.rowPtr[r]; k < m.rowPtr[r + 1]; ++k) m.keep[k] |= m.colGid[k] == m.rowGid[r];
   }
+  if (newMirrors) findMirrors(A);
   CrsMatrix::local_inds_host_view_type inds;
   CrsMatrix::values_host_view_type vals;
   m.a.clear();
+  if (options_.symmetricPart) {
+    // This rank's values, then the mirrors other ranks hold (collective).
+    const std::size_t nnz = m.rowPtr.back();
+    m.rowValues.resize(nnz + m.mirrorsIn);
+    for (LO r = 0; r < nRows; ++r) {
+      A.getLocalRowView(r, inds, vals);
+      std::copy(vals.data(), vals.data() + vals.extent(0), m.rowValues.begin() + m.rowPtr[r]);
+    }
+    m.mirrorsOut.resize(m.mirrorsAsked.size());
+    for (std::size_t i = 0; i < m.mirrorsAsked.size(); ++i)
+      m.mirrorsOut[i] = m.mirrorsAsked[i] == Impl::kNoMirror ? 0.0 : m.rowValues[m.mirrorsAsked[i]];
+    MPI_Alltoallv(m.mirrorsOut.data(), m.askedCounts.data(), m.askedOffsets.data(), MPI_DOUBLE,
+                  m.rowValues.data() + nnz, m.askCounts.data(), m.askOffsets.data(), MPI_DOUBLE, m.comm);
+  }
   for (LO r = 0; r < nRows; ++r) {
     A.getLocalRowView(r, inds, vals);
     const std::size_t k0 = m.rowPtr[r];
     for (std::size_t k = 0; k < vals.extent(0); ++k) {
+      double v = vals(k);
+      if (options_.symmetricPart) {
+        if (m.upper[k0 + k]) continue;
+        if (m.mirror[k0 + k] != Impl::kNoMirror) v = 0.5 * (v + m.rowValues[m.mirror[k0 + k]]);
+      }
       if (!m.keep[k0 + k]) {
-        if (vals(k) == 0) continue;
+        if (v == 0) continue;
         m.keep[k0 + k] = 1, grew = true;
       }
-      m.a.push_back(vals(k));
+      m.a.push_back(v);
     }
   }
   return grew;
+}
+
+// For each entry below the diagonal (row gid > column gid), where its
+// transpose is: an index into rowValues, this rank's entries first, then the
+// ones other ranks send (kNoMirror: not in the pattern, a zero). Entries above
+// the diagonal are marked and dropped (MUMPS reads one triangle of a
+// symmetric matrix). Once a pattern, collective: each row's entries sorted by
+// column for a binary search; the transposes in other ranks' rows asked of
+// their owners, who note which of their entries to send at each factorisation.
+void MumpsSolver::findMirrors(const CrsMatrix& A) {
+  Impl& m = *impl_;
+  const auto& rowMap = *A.getRowMap();
+  const std::size_t nnz = m.rowPtr.back();
+  const LO nRows = static_cast<LO>(m.rowGid.size());
+  auto& byColumn = m.byColumn;  // kept: fresh pages cost more than the sort
+  byColumn.resize(nnz);
+  for (std::size_t k = 0; k < nnz; ++k) byColumn[k] = {m.colGid[k], k};
+  for (LO r = 0; r < nRows; ++r) std::sort(byColumn.begin() + m.rowPtr[r], byColumn.begin() + m.rowPtr[r + 1]);
+  auto find = [&](LO row, GO col) {
+    const auto b = byColumn.begin() + m.rowPtr[row], e = byColumn.begin() + m.rowPtr[row + 1];
+    const auto it = std::lower_bound(b, e, std::make_pair(col, std::size_t(0)));
+    return it != e && it->first == col ? it->second : Impl::kNoMirror;
+  };
+  m.upper.assign(nnz, 0);
+  m.mirror.assign(nnz, Impl::kNoMirror);
+  std::vector<std::size_t> remote;  // entries whose transpose row is another rank's
+  std::vector<GO> remoteRows;
+  for (LO r = 0; r < nRows; ++r)
+    for (std::size_t k = m.rowPtr[r]; k < m.rowPtr[r + 1]; ++k) {
+      if (m.colGid[k] > m.rowGid[r]) {
+        m.upper[k] = 1, m.keep[k] = 0;
+        continue;
+      }
+      if (m.colGid[k] == m.rowGid[r]) continue;
+      const LO t = rowMap.getLocalElement(m.colGid[k]);
+      if (t != Teuchos::OrdinalTraits<LO>::invalid())
+        m.mirror[k] = find(t, m.rowGid[r]);
+      else
+        remote.push_back(k), remoteRows.push_back(m.colGid[k]);
+    }
+  // Ask each owner, grouped by rank, for (its row, our row) pairs.
+  // Their owners, looked up once per row: Tpetra 13.2's directory answered
+  // -1 for some ids of a list with repeats (the cyclic map in test_mumps).
+  std::vector<GO> rows(remoteRows);
+  std::sort(rows.begin(), rows.end());
+  rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
+  std::vector<int> rowOwner(rows.size());
+  std::vector<LO> rowLid(rows.size());
+  rowMap.getRemoteIndexList(Teuchos::ArrayView<const GO>(rows), Teuchos::arrayViewFromVector(rowOwner),
+                            Teuchos::arrayViewFromVector(rowLid));
+  std::vector<int> owner(remote.size());
+  for (std::size_t i = 0; i < remote.size(); ++i)
+    owner[i] = rowOwner[std::lower_bound(rows.begin(), rows.end(), remoteRows[i]) - rows.begin()];
+  std::vector<std::size_t> order(remote.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return owner[x] < owner[y]; });
+  m.askCounts.assign(m.size, 0), m.askOffsets.assign(m.size, 0);
+  std::vector<GO> asks(2 * remote.size());
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    const std::size_t k = remote[order[i]];
+    ++m.askCounts[owner[order[i]]];
+    m.mirror[k] = nnz + i;
+    asks[2 * i] = m.colGid[k];
+    asks[2 * i + 1] = m.rowGid[std::upper_bound(m.rowPtr.begin(), m.rowPtr.end(), k) - m.rowPtr.begin() - 1];
+  }
+  for (int p = 1; p < m.size; ++p) m.askOffsets[p] = m.askOffsets[p - 1] + m.askCounts[p - 1];
+  m.askedCounts.assign(m.size, 0), m.askedOffsets.assign(m.size, 0);
+  MPI_Alltoall(m.askCounts.data(), 1, MPI_INT, m.askedCounts.data(), 1, MPI_INT, m.comm);
+  for (int p = 1; p < m.size; ++p) m.askedOffsets[p] = m.askedOffsets[p - 1] + m.askedCounts[p - 1];
+  const int asked = m.askedOffsets.back() + m.askedCounts.back();
+  std::vector<int> pairCounts(m.size), pairOffsets(m.size), pairsInCounts(m.size), pairsInOffsets(m.size);
+  for (int p = 0; p < m.size; ++p) {
+    pairCounts[p] = 2 * m.askCounts[p], pairOffsets[p] = 2 * m.askOffsets[p];
+    pairsInCounts[p] = 2 * m.askedCounts[p], pairsInOffsets[p] = 2 * m.askedOffsets[p];
+  }
+  std::vector<GO> pairsIn(2 * std::size_t(asked));
+  static_assert(sizeof(GO) == sizeof(long long), "global ids are long long");
+  MPI_Alltoallv(asks.data(), pairCounts.data(), pairOffsets.data(), MPI_LONG_LONG, pairsIn.data(),
+                pairsInCounts.data(), pairsInOffsets.data(), MPI_LONG_LONG, m.comm);
+  m.mirrorsAsked.resize(asked);
+  for (int i = 0; i < asked; ++i) {
+    const LO t = rowMap.getLocalElement(pairsIn[2 * i]);
+    m.mirrorsAsked[i] = t == Teuchos::OrdinalTraits<LO>::invalid() ? Impl::kNoMirror : find(t, pairsIn[2 * i + 1]);
+  }
+  m.mirrorsIn = remote.size();
 }
 
 void MumpsSolver::factor(const CrsMatrix& A) {

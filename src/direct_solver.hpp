@@ -8,7 +8,8 @@
 // Each rank hands MUMPS its own rows (distributed assembled input, ICNTL(18) = 3,
 // 1-based global indices; on one rank, or below MumpsOptions::hostOnlyBelow,
 // the whole matrix on rank 0); right-hand sides are gathered to rank 0 (MUMPS'
-// host) and the solution is scattered back. Unsymmetric mode (SYM = 0). The
+// host) and the solution is scattered back. Unsymmetric mode (SYM = 0), or
+// symmetric (SYM = 2) on A's symmetric part (MumpsOptions::symmetricPart). The
 // factors are double (dmumps) or single precision (smumps, MumpsOptions::
 // precision: for the LU preconditioner).
 //
@@ -92,6 +93,14 @@ struct MumpsOptions {
   // a solve of its own (the direct solve's factory refuses it).
   enum class Precision { Double, Single };
   Precision precision = Precision::Double;
+  // Factor the symmetric part (A + A^T) / 2 as a symmetric matrix (LDL^T,
+  // SYM = 2): about half the factors' entries and work, and a preconditioner
+  // for GMRES only (not A's solve; the direct solve's factory refuses it).
+  // capstan's frictionless tangents are nearly symmetric (Cauchy stress
+  // 2c(B - I) is not hyperelastic off J = 1: |A - A^T| about 3e-3 of |A| on
+  // G1). Transposes in other ranks' rows are exchanged at each
+  // factorisation. G1 2x: docs/performance.md.
+  bool symmetricPart = false;
 };
 
 class MumpsSolver {
@@ -146,7 +155,9 @@ class MumpsSolver {
   void initialize(const Teuchos::Comm<int>& comm, bool hostOnly);
   void run(int job);  // MUMPS' JOB on the ranks that run it; INFOG on every rank
   bool extractPattern(const CrsMatrix& A);  // true if this rank's pattern changed
-  bool keepNonzeros(const CrsMatrix& A, bool fresh);  // the values MUMPS reads; true if the kept set grew
+  // The values MUMPS reads; true if the kept set grew. Collective with symmetricPart.
+  bool keepNonzeros(const CrsMatrix& A, bool fresh, bool newMirrors);
+  void findMirrors(const CrsMatrix& A);  // symmetricPart: where each lower entry's transpose is (collective)
   void analyse(const CrsMatrix& A);
   void computeMetisOrdering();
   double analyseWith(MumpsOptions::Ordering ordering);  // one analysis; returns its estimated flops

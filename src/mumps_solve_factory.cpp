@@ -145,6 +145,9 @@ RCP<const Teuchos::ParameterList> validMumpsOptions() {
     valid->set("Precision", std::string("Double"),
                "Double | Single: the factorisation's arithmetic; Single (half the memory) only as GMRES' "
                "preconditioner (Solver/Preconditioner = LU), whose iterations restore double precision");
+    valid->set("Symmetric Part", false,
+               "Factor (A + A^T) / 2 as a symmetric matrix (LDL^T): half the work, for GMRES' preconditioner "
+               "(Solver/Preconditioner = LU) where A is nearly symmetric; capstan sets it without friction");
     valid->set("Nonzero Pattern", true,
                "MUMPS sees the entries nonzero so far (and the diagonal), the analysis redone when one more turns "
                "nonzero; false: the matrix graph's whole pattern");
@@ -164,6 +167,7 @@ void readMumpsOptions(Teuchos::ParameterList& list, MumpsShared& shared) {
   shared.options.verbose = list.get<bool>("Verbose");
   shared.options.scaling = list.get<bool>("Scaling");
   shared.options.nonzeroPattern = list.get<bool>("Nonzero Pattern");
+  shared.options.symmetricPart = list.get<bool>("Symmetric Part");
   const auto precision = list.get<std::string>("Precision");
   if (precision != "Double" && precision != "Single")
     throw std::invalid_argument("MUMPS: 'Precision' = '" + precision + "' is not Double or Single");
@@ -181,6 +185,10 @@ void MumpsSolveFactory::setParameterList(const RCP<Teuchos::ParameterList>& list
     throw std::invalid_argument(
         "MUMPS: 'Precision' = 'Single' is for the LU preconditioner (Solver/Preconditioner = LU); a direct solve "
         "factorises in Double");
+  if (shared_->options.symmetricPart)
+    throw std::invalid_argument(
+        "MUMPS: 'Symmetric Part' = true is for the LU preconditioner (Solver/Preconditioner = LU); a direct solve "
+        "factorises the matrix itself");
 }
 
 bool MumpsSolveFactory::isCompatible(const Thyra::LinearOpSourceBase<double>& src) const {

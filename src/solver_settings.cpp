@@ -88,6 +88,7 @@ SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterRe
   const std::string at = "Solver";
   SolverSettings s;
   s.linearSolver = r.choice(sol, at, "Linear Solver", linearSolvers);
+  s.unsymmetric = friction || steady;
   s.directSolverMaxDofs = r.atLeast(sol, at, "Direct Solver Max Dofs", 0);
   s.preconditioner = r.choice(sol, at, "Preconditioner",
                               std::vector<std::pair<const char*, Preconditioner>>{

@@ -58,6 +58,11 @@ struct SolverSettings {
   // Set by resolved() for an annulus: MueLu with symmetric Gauss-Seidel
   // smoothing and a drop tolerance, which suit graded rings (src/newton.cpp).
   bool gradedRings = false;
+  // Set by parse() with friction or in steady rolling: Newton's matrix is far
+  // from symmetric. Otherwise it is nearly so (|A - A^T| about 3e-3 of |A| on
+  // G1, from the stress 2c(B - I) off J = 1), and the LU preconditioner
+  // factors its symmetric part (MumpsOptions::symmetricPart).
+  bool unsymmetric = false;
   Teuchos::ParameterList nox, stratimikos;  // passed to NOX and Stratimikos over capstan's defaults
 
   static void declare(Teuchos::ParameterList& solver);

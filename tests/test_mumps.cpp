@@ -66,6 +66,7 @@ struct ConvDiff {
   double shift = 0.0;      // added to the diagonal
   bool farCouplings = false;  // couple g and N-1-g (a different pattern)
   double far = 1.0;           // scales those couplings (0: in the pattern, zero)
+  bool symmetrised = false;   // (A + A^T) / 2 instead of A
 };
 
 // 7-point diffusion plus first-order upwind convection on the 6x5x4 grid,
@@ -81,13 +82,15 @@ RCP<CrsMatrix> convectionDiffusion(RCP<const Map> map, const ConvDiff& c) {
     auto add = [&](bool inside, GO col, double val) {
       if (inside) cols.push_back(col), vals.push_back(val);
     };
-    add(i > 0, g - 1, -1.0 - v[0]);
-    add(i < NX - 1, g + 1, -1.0);
-    add(j > 0, g - NX, -1.0 - v[1]);
-    add(j < NY - 1, g + NX, -1.0);
-    add(k > 0, g - NX * NY, -1.0 - v[2]);
-    add(k < NZ - 1, g + NX * NY, -1.0);
-    if (c.farCouplings) add(true, N - 1 - g, c.far * (g < N / 2 ? 0.7 : -0.4));
+    // Upwind couplings -1 - v behind, -1 ahead; symmetrised, -1 - v/2 both ways.
+    const double h = c.symmetrised ? 0.5 : 1.0;
+    add(i > 0, g - 1, -1.0 - h * v[0]);
+    add(i < NX - 1, g + 1, -1.0 - (1 - h) * v[0]);
+    add(j > 0, g - NX, -1.0 - h * v[1]);
+    add(j < NY - 1, g + NX, -1.0 - (1 - h) * v[1]);
+    add(k > 0, g - NX * NY, -1.0 - h * v[2]);
+    add(k < NZ - 1, g + NX * NY, -1.0 - (1 - h) * v[2]);
+    if (c.farCouplings) add(true, N - 1 - g, c.far * (c.symmetrised ? 0.15 : g < N / 2 ? 0.7 : -0.4));
     A->insertGlobalValues(g, Teuchos::arrayViewFromVector(cols), Teuchos::arrayViewFromVector(vals));
   }
   A->fillComplete();
@@ -344,6 +347,56 @@ TEST(Mumps, SinglePrecisionSolvesToFloatAccuracyAndPreconditionsGmresToDouble) {
   direct.set("Linear Solver Type", "MUMPS");
   direct.set("Preconditioner Type", "None");
   direct.sublist("Linear Solver Types").sublist("MUMPS").set("Precision", "Single");
+  EXPECT_THROW(capstan::linearSolverFactories(direct), std::invalid_argument);
+}
+
+// Symmetric Part: A's symmetric part (A + A^T) / 2 factored as a symmetric
+// matrix (LDL^T): a solve is S's, exact, on every rank count, where each
+// rank's rows reach transposes in other ranks' rows (the cyclic map: nearly
+// all of them; the far couplings cross the contiguous map's halves). Fewer
+// factor entries than A's LU; GMRES on A with it as preconditioner converges
+// to double precision; the direct solve's factory refuses it.
+TEST(Mumps, SymmetricPartSolvesTheSymmetricPartOnEveryRankCount) {
+  for (auto map : {contiguousMap(N, worldComm()), cyclicReversedMap(N, worldComm())}) {
+    MumpsOptions o = testOptions();
+    o.symmetricPart = true;
+    MumpsSolver solver(o), lu(testOptions());
+    for (double velocity : {1.0, 0.5}) {  // a refactorisation with the same pattern too
+      ConvDiff c{velocity, 0.0, true};
+      auto A = convectionDiffusion(map, c);
+      c.symmetrised = true;
+      auto S = convectionDiffusion(map, c);
+      solver.factor(*A);
+      solveAndCheck(solver, *S, 3);
+      lu.factor(*A);
+      EXPECT_LT(solver.factorEntries(), lu.factorEntries());
+    }
+    EXPECT_EQ(solver.numAnalyses(), 1);
+    EXPECT_EQ(solver.numFactorizations(), 2);
+    // Zeros in the pattern (the far couplings) turning nonzero: they join it,
+    // a new analysis.
+    MumpsSolver grows(o);
+    grows.factor(*convectionDiffusion(map, ConvDiff{1.0, 0.0, true, 0.0}));
+    grows.factor(*convectionDiffusion(map, ConvDiff{1.0, 0.0, true, 1.0}));
+    solveAndCheck(grows, *convectionDiffusion(map, ConvDiff{1.0, 0.0, true, 1.0, true}), 1);
+    EXPECT_EQ(grows.numAnalyses(), 2);
+  }
+
+  auto map = contiguousMap(N, worldComm());
+  auto A = convectionDiffusion(map, ConvDiff{1.0, 0.0, true});
+  auto xTrue = knownSolution(map, 1);
+  MultiVector b(map, 1);
+  A->apply(*xTrue, b);
+  int luIts = 0, symIts = 0;
+  EXPECT_LT(errorAgainst(*xTrue, *solveThrough(capstan::linearSolverFactories(gmresWithMumps()), A, b, luIts)), 1e-11);
+  auto list = gmresWithMumps();
+  list.sublist("Preconditioner Types").sublist("MUMPS").set("Symmetric Part", true);
+  EXPECT_LT(errorAgainst(*xTrue, *solveThrough(capstan::linearSolverFactories(list), A, b, symIts)), 1e-11);
+  EXPECT_GT(symIts, luIts);  // not A's inverse
+  Teuchos::ParameterList direct;
+  direct.set("Linear Solver Type", "MUMPS");
+  direct.set("Preconditioner Type", "None");
+  direct.sublist("Linear Solver Types").sublist("MUMPS").set("Symmetric Part", true);
   EXPECT_THROW(capstan::linearSolverFactories(direct), std::invalid_argument);
 }
 
