@@ -262,18 +262,31 @@ bool MumpsSolver::keepNonzeros(const CrsMatrix& A, bool fresh, bool newMirrors) 
   }
   for (LO r = 0; r < nRows; ++r) {
     A.getLocalRowView(r, inds, vals);
-    const std::size_t k0 = m.rowPtr[r];
-    for (std::size_t k = 0; k < vals.extent(0); ++k) {
-      double v = vals(k);
-      if (options_.symmetricPart) {
-        if (m.upper[k0 + k]) continue;
-        if (m.mirror[k0 + k] != Impl::kNoMirror) v = 0.5 * (v + m.rowValues[m.mirror[k0 + k]]);
+    const std::size_t k0 = m.rowPtr[r], n = vals.extent(0);
+    for (std::size_t g = 0; g < n;) {
+      // With nonzeroNodeBlocks, a run of entries in one node's columns (its 3
+      // unknowns, side by side in the row) is kept together once any is
+      // nonzero; otherwise each entry is its own run.
+      std::size_t e = g + 1;
+      if (options_.nonzeroNodeBlocks)
+        while (e < n && m.colGid[k0 + e] / 3 == m.colGid[k0 + g] / 3) ++e;
+      double v[3];
+      bool any = false;
+      for (std::size_t k = g; k < e; ++k) {
+        double& x = v[k - g];
+        x = vals(k);
+        if (options_.symmetricPart && m.mirror[k0 + k] != Impl::kNoMirror) x = 0.5 * (x + m.rowValues[m.mirror[k0 + k]]);
+        any = any || (x != 0 && !(options_.symmetricPart && m.upper[k0 + k])) || m.keep[k0 + k];
       }
-      if (!m.keep[k0 + k]) {
-        if (v == 0) continue;
-        m.keep[k0 + k] = 1, grew = true;
+      for (std::size_t k = g; k < e; ++k) {
+        if (options_.symmetricPart && m.upper[k0 + k]) continue;
+        if (!m.keep[k0 + k]) {
+          if (!any) continue;
+          m.keep[k0 + k] = 1, grew = true;
+        }
+        m.a.push_back(v[k - g]);
       }
-      m.a.push_back(v);
+      g = e;
     }
   }
   return grew;

@@ -87,6 +87,16 @@ struct MumpsOptions {
   // zone settles) cost 3-24 ms each (docs/performance.md, "Linear solvers").
   // Off: the matrix graph's pattern, zeros and all.
   bool nonzeroPattern = true;
+  // With nonzeroPattern: the entries of a row in one node's columns (its 3
+  // unknowns) join the pattern together, once any of them is nonzero. A zero
+  // inside a coupled node pair is then an accident of the values (an
+  // undeformed regular mesh's symmetry), not an entity at rest, and its
+  // turning nonzero later need not redo the analysis. capstan sets it with
+  // symmetricPart (no friction): G1 2x one analysis against two, 1.40-1.43
+  // against 1.53-1.62 s on 1 rank, 0.97-1.00 against 1.12-1.27 s on 2. Not
+  // with friction: the steady 3D drive's factors grew from 0.73 to 0.84 M
+  // entries (5 analyses against 7, the same run time).
+  bool nonzeroNodeBlocks = false;
   // The factorisation's arithmetic. Single (smumps): half the factors' memory
   // and traffic, a factorisation accurate to about 1e-7 x the condition
   // number: a preconditioner for GMRES, which restores double precision, not

@@ -153,9 +153,15 @@ Teuchos::ParameterList stratimikosList(const SolverSettings& solver, const Assem
       // 0.9 GB a rank against 135 s and 1.3 GB, the same Newton iterations
       // and answers to 1e-8 (docs/performance.md, "Defaults and why").
       p.sublist("Preconditioner Types").sublist("MUMPS").set("Precision", "Single");
-      // Without friction, its symmetric part in LDL^T: G1 2x 1.51-1.56 s against
-      // 2.22-2.25 s on 1 rank, 1.08-1.10 against 1.44-1.54 s on 2 (docs/performance.md).
-      if (!solver.unsymmetric) p.sublist("Preconditioner Types").sublist("MUMPS").set("Symmetric Part", true);
+      // Without friction, its symmetric part in LDL^T (G1 2x 1.51-1.56 s against
+      // 2.22-2.25 s on 1 rank, 1.08-1.10 against 1.44-1.54 s on 2), with the
+      // nonzero pattern by node blocks (one analysis: 1.40-1.43 s, 0.97-1.00 s on
+      // 2 ranks; docs/performance.md, src/direct_solver.hpp).
+      if (!solver.unsymmetric) {
+        auto& mumps = p.sublist("Preconditioner Types").sublist("MUMPS");
+        mumps.set("Symmetric Part", true);
+        mumps.set("Nonzero Node Blocks", true);
+      }
     } else if (prec == S::Preconditioner::MueLu) {
       // Smoothed aggregation with the rigid-body modes, Chebyshev smoothing.
       p.set("Preconditioner Type", "MueLu");

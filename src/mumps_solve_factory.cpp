@@ -145,6 +145,9 @@ RCP<const Teuchos::ParameterList> validMumpsOptions() {
     valid->set("Precision", std::string("Double"),
                "Double | Single: the factorisation's arithmetic; Single (half the memory) only as GMRES' "
                "preconditioner (Solver/Preconditioner = LU), whose iterations restore double precision");
+    valid->set("Nonzero Node Blocks", false,
+               "With Nonzero Pattern: a row's entries in one node's columns join the pattern together once any is "
+               "nonzero; capstan sets it without friction");
     valid->set("Symmetric Part", false,
                "Factor (A + A^T) / 2 as a symmetric matrix (LDL^T): half the work, for GMRES' preconditioner "
                "(Solver/Preconditioner = LU) where A is nearly symmetric; capstan sets it without friction");
@@ -168,6 +171,7 @@ void readMumpsOptions(Teuchos::ParameterList& list, MumpsShared& shared) {
   shared.options.scaling = list.get<bool>("Scaling");
   shared.options.nonzeroPattern = list.get<bool>("Nonzero Pattern");
   shared.options.symmetricPart = list.get<bool>("Symmetric Part");
+  shared.options.nonzeroNodeBlocks = list.get<bool>("Nonzero Node Blocks");
   const auto precision = list.get<std::string>("Precision");
   if (precision != "Double" && precision != "Single")
     throw std::invalid_argument("MUMPS: 'Precision' = '" + precision + "' is not Double or Single");

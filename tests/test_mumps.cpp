@@ -746,6 +746,44 @@ RCP<CrsMatrix> elasticityLike(int n, RCP<const Comm> comm) {
   return A;
 }
 
+// Nonzero Node Blocks: a row's entries in one node's columns join the pattern
+// together, so zeros inside a coupled node pair (here the axis-aligned
+// neighbours' cross terms) are in it from the start, and their turning nonzero
+// does not redo the analysis; entry by entry it does.
+TEST(Mumps, NodeBlocksKeepZerosInsideCoupledNodes) {
+  auto A = elasticityLike(4, worldComm());
+  auto filled = rcp(new CrsMatrix(*A, Teuchos::Copy));  // every stored zero made 1e-3
+  filled->resumeFill();
+  long zeros = 0;
+  for (LO r = 0; r < LO(A->getNodeNumRows()); ++r) {
+    CrsMatrix::local_inds_host_view_type inds;
+    CrsMatrix::values_host_view_type vals;
+    A->getLocalRowView(r, inds, vals);
+    for (std::size_t k = 0; k < vals.extent(0); ++k)
+      if (vals(k) == 0) {
+        ++zeros;
+        const LO col = inds(k);
+        filled->replaceLocalValues(r, Teuchos::tuple<LO>(col), Teuchos::tuple<double>(1e-3));
+      }
+  }
+  filled->fillComplete();
+  long allZeros = 0;
+  Teuchos::reduceAll(*worldComm(), Teuchos::REDUCE_SUM, zeros, Teuchos::outArg(allZeros));
+  ASSERT_GT(allZeros, 0);
+  MumpsOptions blocks = testOptions();
+  blocks.nonzeroNodeBlocks = true;
+  MumpsSolver byNode(blocks), byEntry(testOptions());
+  byNode.factor(*A);
+  byEntry.factor(*A);
+  solveAndCheck(byNode, *A, 1);
+  byNode.factor(*filled);
+  byEntry.factor(*filled);
+  EXPECT_EQ(byNode.numAnalyses(), 1);
+  EXPECT_EQ(byEntry.numAnalyses(), 2);
+  solveAndCheck(byNode, *filled, 2);
+  solveAndCheck(byEntry, *filled, 2);
+}
+
 MumpsOptions::Ordering orderingFromEnv() {
   using O = MumpsOptions::Ordering;
   const char* s = std::getenv("CAPSTAN_MUMPS_ORDERING");
