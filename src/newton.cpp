@@ -406,6 +406,8 @@ bool NewtonSolver::iterative() const {
   return !impl_->newtonPrecFactory.is_null() && impl_->solver.preconditioner != SolverSettings::Preconditioner::LU;
 }
 
+bool NewtonSolver::direct() const { return impl_->solver.linearSolver == SolverSettings::LinearSolver::Direct; }
+
 int NewtonSolver::preconditionerBuilds() const {
   return impl_->newtonPrecFactory.is_null() ? 0 : impl_->newtonPrecFactory->builds();
 }

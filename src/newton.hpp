@@ -78,6 +78,8 @@ class NewtonSolver {
   // multigrid or ILU preconditioner (false: a direct solver, or an LU
   // preconditioner, whose inverse is that of a matrix near Newton's).
   bool iterative() const;
+  // Whether Newton's solves are direct (a factorisation every iteration).
+  bool direct() const;
   // The linear solver and preconditioner parameters in use (Stratimikos list).
   const Teuchos::ParameterList& linearSolverParameters() const;
 

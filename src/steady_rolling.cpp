@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "effects/steady_friction.hpp"
+#include "newton.hpp"
 #include "rolling.hpp"
 
 namespace capstan {
@@ -39,9 +40,12 @@ constexpr int kStageRefinements = 2;
 // saddle-point step (AugmentationLoop::solve's passLimit). The drive 43 Newton
 // iterations against 52 with each converged, the slice 18/22, the braked
 // slice 19/25, the Carter coating 18/22; the 126k-dof drive on 2 ranks 49
-// against 56 (118 s against 122 s). The footprint stays converged: one pass
-// of it too took the drive to 39, but the 126k drive to 175 s (its first Tanh
-// solve, GMRES with a kept LU, 1,087 Krylov iterations against 184).
+// against 56 (118 s against 122 s). The frictionless footprint too, where
+// Newton's solves are direct: the drive 42 against 44, the slice 15/18, the
+// Carter coating 11/14, mu = 2 71/82, the sweeps 1-3 fewer. With GMRES and a
+// kept LU (above the direct solver's size) it stays converged: one pass took
+// the 126k drive to 175 s (its first Tanh solve 1,087 Krylov iterations
+// against 184).
 constexpr int kGuessPasses = 1;
 // Where the steady state after the Tanh stages fails, it is solved again from
 // their answer with Coulomb's stick (eps_t, its tangential penalty) this much
@@ -96,7 +100,7 @@ bool SteadyRolling::startFromRest(double t, StepRecord& rec, std::string& failur
   holdCores(true);
   enableFriction(false);
   predictors_.linearResponse(t, rec);
-  if (!solveStage(t, "frictionless footprint", rec, failure)) return false;
+  if (!solveStage(t, "frictionless footprint", rec, failure, m_.newton->direct() ? kGuessPasses : 0)) return false;
   enableFriction(true);
   const auto widened = frictionsStartedWide();
   if (!widened.empty()) {
