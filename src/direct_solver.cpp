@@ -104,9 +104,9 @@ struct MumpsSolver::Impl {
   // diagonal. a, irn and jcn hold the kept entries only, in the same order.
   std::vector<char> keep;
   // symmetricPart: the pattern's entries above the diagonal (by global ids),
-  // never read; for those below, the flat index of the transpose entry on
-  // this rank (kNoMirror if its row is another rank's), and the values of
-  // this rank's rows in pattern order.
+  // never read; for those below, where the transpose entry's value is in
+  // rowValues (findMirrors; kNoMirror: none, a zero): this rank's rows in
+  // pattern order, then the values other ranks send.
   static constexpr std::size_t kNoMirror = std::size_t(-1);
   std::vector<char> upper;
   std::vector<std::size_t> mirror;
@@ -269,7 +269,7 @@ bool MumpsSolver::keepNonzeros(const CrsMatrix& A, bool fresh, bool newMirrors) 
       // nonzero; otherwise each entry is its own run.
       std::size_t e = g + 1;
       if (options_.nonzeroNodeBlocks)
-        while (e < n && m.colGid[k0 + e] / 3 == m.colGid[k0 + g] / 3) ++e;
+        while (e < n && e - g < 3 && m.colGid[k0 + e] / 3 == m.colGid[k0 + g] / 3) ++e;
       double v[3];
       bool any = false;
       for (std::size_t k = g; k < e; ++k) {
