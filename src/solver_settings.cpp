@@ -173,14 +173,16 @@ SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterRe
 SolverSettings SolverSettings::resolved(long dofs, bool annulus, bool friction, bool steady) const {
   SolverSettings s = *this;
   s.gradedRings = gradedRings || annulus;  // NewtonSolver resolves again, knowing no mesh
-  // Auto's direct size: 50,000 on an annulus; on a box 5,000, and 12,000 for
-  // the monolithic loop (no friction), whose steps a factorisation serves
-  // better than MueLu's V-cycle: G1 2x (10,179 unknowns) 2.14 s with the LU
-  // preconditioner against 4.41 s with MueLu; G1 3x (31,863) 15.7 s against
-  // 16.1 s, with 1.6x the memory (docs/performance.md, "Defaults and why").
+  // Auto's direct size: 50,000 on an annulus; on a box 5,000, and 40,000 for
+  // the monolithic loop (no friction), whose steps a factorisation (of the
+  // symmetric part) serves better than MueLu's V-cycle: G1 2x (10,179
+  // unknowns) 1.40 s with the LU preconditioner against 4.35 s with MueLu;
+  // G1 3x (31,863) 13.8-13.9 s against 16.4-16.6 s, with 1.5x the memory
+  // (395 against 268 MiB); G1 4x (72,675) 75.4 s against 46.6 s
+  // (docs/performance.md, "Defaults and why").
   const long most = s.directSolverMaxDofs > 0 ? s.directSolverMaxDofs
                     : annulus                  ? 50000
-                    : s.monolithic && !friction ? 12000
+                    : s.monolithic && !friction ? 40000
                                                : 5000;
   if (s.linearSolver == LinearSolver::Auto && steady) {
     // Steady rolling: a factorisation every Newton iteration up to the direct

@@ -665,7 +665,7 @@ TEST_F(SceneTest, UnreachableCapstanWarning) {
 }  // namespace
 
 // Linear Solver = Auto by the scene's kind and size (docs/performance.md,
-// "Linear solvers"): MUMPS up to 5,000 dofs on a box (12,000 for the
+// "Linear solvers"): MUMPS up to 5,000 dofs on a box (40,000 for the
 // monolithic pressure loop), 50,000 on an annulus;
 // factorised every Newton iteration with friction, kept as GMRES's LU
 // preconditioner without; GMRES with MueLu (ILU below 1000 dofs) above.
@@ -682,9 +682,10 @@ TEST(SolverSettings, AutoResolvesByKindAndSize) {
   EXPECT_EQ(pick(s, 1920, true, true).first, S::LinearSolver::Direct);
   EXPECT_EQ(pick(s, 5000, false, true).first, S::LinearSolver::Direct);
   EXPECT_EQ(pick(s, 5001, false, true), std::make_pair(S::LinearSolver::GMRES, S::Preconditioner::MueLu));
-  // The monolithic loop (no friction) keeps the LU preconditioner up to 12,000 on a box.
+  // The monolithic loop (no friction) keeps the LU preconditioner up to 40,000 on a box.
   EXPECT_EQ(pick(s, 10179, false, false), std::make_pair(S::LinearSolver::GMRES, S::Preconditioner::LU));
-  EXPECT_EQ(pick(s, 12001, false, false), std::make_pair(S::LinearSolver::GMRES, S::Preconditioner::MueLu));
+  EXPECT_EQ(pick(s, 31863, false, false), std::make_pair(S::LinearSolver::GMRES, S::Preconditioner::LU));
+  EXPECT_EQ(pick(s, 40001, false, false), std::make_pair(S::LinearSolver::GMRES, S::Preconditioner::MueLu));
   S nested = s;
   nested.monolithic = false;
   EXPECT_EQ(pick(nested, 10179, false, false), std::make_pair(S::LinearSolver::GMRES, S::Preconditioner::MueLu));
