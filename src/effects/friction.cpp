@@ -148,7 +148,7 @@ void FrictionEffect::multiplierMap(const Kokkos::View<double*>& next) const {
       });
 }
 
-long FrictionEffect::notePass(bool mayHold) {
+long FrictionEffect::notePass(bool mayHold, bool lastResort) {
   if (!stepsForItself()) return 0;
   auto pts = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), points_);
   const size_t nf = pts.extent(0);
@@ -160,8 +160,12 @@ long FrictionEffect::notePass(bool mayHold) {
       const size_t k = f * kernels::kMaxFacePoints + q;
       auto& c = cycles_[k];
       const int now = int(pts(f, q, kState));
-      // A, B, A: one return; A, B, A, B, A: three, a cycle.
+      // A, B, A: one return; A, B, A, B, A: three, a cycle. Changes: between
+      // stick and slip, while in contact.
+      if (now != 0 && c.last > 0 && now != c.last) ++c.changes;
       if (now != 0 && now != c.last && now == c.beforeLast && ++c.returns >= 3 && mayHold && !c.held)
+        c.held = true, newlyHeld.push_back(k);
+      else if (lastResort && now != 0 && c.changes >= 4 && !c.held)
         c.held = true, newlyHeld.push_back(k);
       c.beforeLast = c.last, c.last = now;
     }

@@ -71,9 +71,10 @@ class FrictionEffect : public Effect {
   // stick/slip state has gone A, B, A, B, A over five passes (the multiplier loop
   // cycling at the stick zone's edge, where |t| = mu t_n to within the step's
   // reach) is held in slip, at the cone, for the rest of the solve, where the
-  // loop has stopped making progress (mayHold); released at the next solve.
-  // Returns the points held so far.
-  long notePass(bool mayHold);
+  // loop has stopped making progress (mayHold); with lastResort (it has not
+  // for longer), any point whose state has changed four times or more in the
+  // solve too. Released at the next solve. Returns the points held so far.
+  long notePass(bool mayHold, bool lastResort);
   void releaseHeldSlips();
   double constraintViolation() const override;
   double constraintTolerance() const override { return contact_.constraintTolerance(); }
@@ -120,6 +121,7 @@ class FrictionEffect : public Effect {
     int beforeLast = -1;  // two passes ago
     int last = -1;        // the last pass
     int returns = 0;      // passes back to the state of two passes before
+    int changes = 0;      // passes whose state (in contact) differed from the last
     bool held = false;
   };
   std::vector<PointCycle> cycles_;  // [face * kMaxFacePoints + q]
