@@ -64,9 +64,10 @@ constexpr int kHoldAfterPasses = 3;
 // The last resort, once it has not for this many (of the kStallPasses that
 // end the solve): every point whose state has changed four times or more in
 // the solve is held in slip too. On the finest nips the loop's chatter is not
-// a 2-cycle: points go stick, slip, slip, stick, slip, slip, stick (3x160x16,
-// and uniform radial cells: 3x160x8 with Outer Cell Ratio = 1 then converges
-// in 63 Newton iterations and 25 s, where it was cut 7 times in 13 min).
+// a 2-cycle: points go stick, slip, slip, stick, slip, slip, stick. Uniform
+// radial cells (3x160x8, Outer Cell Ratio = 1) then converge in 63 Newton
+// iterations and 25 s, where they were cut 7 times in 13 min (3x160x16 does
+// not: its Newton solves stagnate).
 // After 3 passes instead, it also held points where the loop was to converge
 // (3x100x8: 61 Newton iterations against 54, the speed ratio 1.4e-4 away);
 // after 6, every scene that converged converges as before, to the bit.
