@@ -162,8 +162,8 @@ if runs.get(1) and runs.get(2):
     dr = abs(a["supports"]["core"]["speed_ratio"] - b["supports"]["core"]["speed_ratio"])
     Fa, Fb = a["capstans"]["capstan"]["force"], b["capstans"]["capstan"]["force"]
     dF = max(abs(x - y) for x, y in zip(Fa, Fb)) / max(abs(x) for x in Fa)
-    # Which points cycle, and so which are held, follows each run's own round-off (2 ranks
-    # held 52 points where 1 held 44, 9.7e-6 apart): the held points sit at the cone, where
+    # Which points cycle, and so which are held, follows each run's own round-off (44 points
+    # each, held at other passes, 1.1e-5 apart): the held points sit at the cone, where
     # Coulomb's answer depends on the path to its tolerance's level (2.3e-5,
     # docs/steady-rolling.md), not to 1e-8 as where nothing is held.
     T.check(dr <= 3e-5 and dF <= 3e-5, f"fine nip: 2 ranks against 1, speed ratio {dr:.1e}, force {dF:.1e} (3e-5)")
