@@ -51,6 +51,140 @@ bool anyRank(bool local, MPI_Comm comm) {
   return out != 0;
 }
 
+// MumpsOptions::symmetricPart: for a square matrix distributed by rows, which
+// entries lie above the diagonal (by global ids: MUMPS reads one triangle of a
+// symmetric matrix) and, for each below it, where its transpose's value is, on
+// this rank or another (then exchanged at each factorisation). Built once a
+// pattern: each row's entries sorted by column for a binary search; the
+// transposes in other ranks' rows asked of their owners, who note which of
+// their entries to send. Both calls are collective.
+class TransposeEntries {
+ public:
+  using CrsMatrix = Tpetra::CrsMatrix<>;
+  static constexpr std::size_t kNone = std::size_t(-1);
+
+  // This rank's pattern: global row ids, CRS offsets, global column ids.
+  void build(const Map& rowMap, const std::vector<GO>& rowGid, const std::vector<std::size_t>& rowPtr,
+             const std::vector<GO>& colGid, MPI_Comm comm);
+  // A's values on this rank's rows (in pattern order), then the transposes
+  // other ranks hold.
+  void gather(const CrsMatrix& A, MPI_Comm comm);
+  bool upper(std::size_t k) const { return upper_[k]; }
+  // Entry k's share of (A + A^T) / 2: its value where it has no transpose (the
+  // diagonal, or none in the pattern), else the mean of the two.
+  double symmetric(std::size_t k) const {
+    return mirror_[k] == kNone ? values_[k] : 0.5 * (values_[k] + values_[mirror_[k]]);
+  }
+
+ private:
+  std::vector<char> upper_;
+  std::vector<std::size_t> mirror_;  // index into values_
+  std::vector<double> values_;       // this rank's, then remoteCount_ from other ranks
+  std::size_t local_ = 0, remoteCount_ = 0;
+  // Asked of other ranks (askCounts_, askOffsets_ per rank); asked of us
+  // (askedCounts_, askedOffsets_; entries asked_, indices into values_).
+  std::vector<int> askCounts_, askOffsets_, askedCounts_, askedOffsets_;
+  std::vector<std::size_t> asked_;
+  std::vector<double> sent_;
+  std::vector<std::pair<GO, std::size_t>> byColumn_;  // kept: fresh pages cost more than the sort
+};
+
+void TransposeEntries::build(const Map& rowMap, const std::vector<GO>& rowGid, const std::vector<std::size_t>& rowPtr,
+                             const std::vector<GO>& colGid, MPI_Comm comm) {
+  int size = 1;
+  MPI_Comm_size(comm, &size);
+  const std::size_t nnz = rowPtr.back();
+  const LO nRows = static_cast<LO>(rowGid.size());
+  local_ = nnz;
+  byColumn_.resize(nnz);
+  for (std::size_t k = 0; k < nnz; ++k) byColumn_[k] = {colGid[k], k};
+  for (LO r = 0; r < nRows; ++r) std::sort(byColumn_.begin() + rowPtr[r], byColumn_.begin() + rowPtr[r + 1]);
+  auto find = [&](LO row, GO col) {
+    const auto b = byColumn_.begin() + rowPtr[row], e = byColumn_.begin() + rowPtr[row + 1];
+    const auto it = std::lower_bound(b, e, std::make_pair(col, std::size_t(0)));
+    return it != e && it->first == col ? it->second : kNone;
+  };
+  upper_.assign(nnz, 0);
+  mirror_.assign(nnz, kNone);
+  std::vector<std::size_t> remote;  // entries whose transpose row is another rank's
+  std::vector<GO> remoteRows;
+  for (LO r = 0; r < nRows; ++r)
+    for (std::size_t k = rowPtr[r]; k < rowPtr[r + 1]; ++k) {
+      if (colGid[k] > rowGid[r]) {
+        upper_[k] = 1;
+        continue;
+      }
+      if (colGid[k] == rowGid[r]) continue;
+      const LO t = rowMap.getLocalElement(colGid[k]);
+      if (t != Teuchos::OrdinalTraits<LO>::invalid())
+        mirror_[k] = find(t, rowGid[r]);
+      else
+        remote.push_back(k), remoteRows.push_back(colGid[k]);
+    }
+  // Their owners, looked up once per row: Tpetra 13.2's directory answered -1
+  // for some ids of a list with repeats (the cyclic map in test_mumps).
+  std::vector<GO> rows(remoteRows);
+  std::sort(rows.begin(), rows.end());
+  rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
+  std::vector<int> rowOwner(rows.size());
+  std::vector<LO> rowLid(rows.size());
+  rowMap.getRemoteIndexList(Teuchos::ArrayView<const GO>(rows), Teuchos::arrayViewFromVector(rowOwner),
+                            Teuchos::arrayViewFromVector(rowLid));
+  std::vector<int> owner(remote.size());
+  for (std::size_t i = 0; i < remote.size(); ++i)
+    owner[i] = rowOwner[std::lower_bound(rows.begin(), rows.end(), remoteRows[i]) - rows.begin()];
+  // Ask each owner, grouped by rank, for (its row, our row) pairs; the answers
+  // arrive in that order after this rank's values.
+  std::vector<std::size_t> order(remote.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return owner[x] < owner[y]; });
+  askCounts_.assign(size, 0), askOffsets_.assign(size, 0);
+  std::vector<GO> asks(2 * remote.size());
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    const std::size_t k = remote[order[i]];
+    ++askCounts_[owner[order[i]]];
+    mirror_[k] = nnz + i;
+    asks[2 * i] = colGid[k];
+    asks[2 * i + 1] = rowGid[std::upper_bound(rowPtr.begin(), rowPtr.end(), k) - rowPtr.begin() - 1];
+  }
+  for (int p = 1; p < size; ++p) askOffsets_[p] = askOffsets_[p - 1] + askCounts_[p - 1];
+  askedCounts_.assign(size, 0), askedOffsets_.assign(size, 0);
+  MPI_Alltoall(askCounts_.data(), 1, MPI_INT, askedCounts_.data(), 1, MPI_INT, comm);
+  for (int p = 1; p < size; ++p) askedOffsets_[p] = askedOffsets_[p - 1] + askedCounts_[p - 1];
+  const int asked = askedOffsets_.back() + askedCounts_.back();
+  std::vector<int> pairCounts(size), pairOffsets(size), pairsInCounts(size), pairsInOffsets(size);
+  for (int p = 0; p < size; ++p) {
+    pairCounts[p] = 2 * askCounts_[p], pairOffsets[p] = 2 * askOffsets_[p];
+    pairsInCounts[p] = 2 * askedCounts_[p], pairsInOffsets[p] = 2 * askedOffsets_[p];
+  }
+  std::vector<GO> pairsIn(2 * std::size_t(asked));
+  static_assert(sizeof(GO) == sizeof(long long), "global ids are long long");
+  MPI_Alltoallv(asks.data(), pairCounts.data(), pairOffsets.data(), MPI_LONG_LONG, pairsIn.data(),
+                pairsInCounts.data(), pairsInOffsets.data(), MPI_LONG_LONG, comm);
+  asked_.resize(asked);
+  for (int i = 0; i < asked; ++i) {
+    const LO t = rowMap.getLocalElement(pairsIn[2 * i]);
+    asked_[i] = t == Teuchos::OrdinalTraits<LO>::invalid() ? kNone : find(t, pairsIn[2 * i + 1]);
+  }
+  remoteCount_ = remote.size();
+}
+
+void TransposeEntries::gather(const CrsMatrix& A, MPI_Comm comm) {
+  values_.resize(local_ + remoteCount_);
+  CrsMatrix::local_inds_host_view_type inds;
+  CrsMatrix::values_host_view_type vals;
+  std::size_t k = 0;
+  for (LO r = 0; r < LO(A.getNodeNumRows()); ++r) {
+    A.getLocalRowView(r, inds, vals);
+    std::copy(vals.data(), vals.data() + vals.extent(0), values_.begin() + k);
+    k += vals.extent(0);
+  }
+  sent_.resize(asked_.size());
+  for (std::size_t i = 0; i < asked_.size(); ++i) sent_[i] = asked_[i] == kNone ? 0.0 : values_[asked_[i]];
+  MPI_Alltoallv(sent_.data(), askedCounts_.data(), askedOffsets_.data(), MPI_DOUBLE, values_.data() + local_,
+                askCounts_.data(), askOffsets_.data(), MPI_DOUBLE, comm);
+}
+
 }  // namespace
 
 struct MumpsSolver::Impl {
@@ -103,23 +237,7 @@ struct MumpsSolver::Impl {
   // with nonzeroPattern those nonzero since the pattern was new, and the
   // diagonal. a, irn and jcn hold the kept entries only, in the same order.
   std::vector<char> keep;
-  // symmetricPart: the pattern's entries above the diagonal (by global ids),
-  // never read; for those below, where the transpose entry's value is in
-  // rowValues (findMirrors; kNoMirror: none, a zero): this rank's rows in
-  // pattern order, then the values other ranks send.
-  static constexpr std::size_t kNoMirror = std::size_t(-1);
-  std::vector<char> upper;
-  std::vector<std::size_t> mirror;
-  std::vector<double> rowValues;
-  // The mirrors in other ranks' rows: asked of their owners (askCounts,
-  // askOffsets per rank; mirrorsIn of them arrive at rowValues' end);
-  // ours that they asked for (mirrorsAsked, indices into rowValues, sent as
-  // mirrorsOut; askedCounts, askedOffsets per rank).
-  std::vector<int> askCounts, askOffsets, askedCounts, askedOffsets;
-  std::vector<std::size_t> mirrorsAsked;
-  std::size_t mirrorsIn = 0;
-  std::vector<std::pair<GO, std::size_t>> byColumn;  // findMirrors' scratch
-  std::vector<double> mirrorsOut;
+  TransposeEntries transposes;  // symmetricPart
 
   // What MUMPS reads: 1-based global row / column numbers and the values.
   // Rows are numbered rank by rank in local order (rank r's rows are
@@ -242,24 +360,16 @@ bool MumpsSolver::keepNonzeros(const CrsMatrix& A, bool fresh, bool newMirrors) 
     for (LO r = 0; r < nRows; ++r)
       for (std::size_t k = m.rowPtr[r]; k < m.rowPtr[r + 1]; ++k) m.keep[k] |= m.colGid[k] == m.rowGid[r];
   }
-  if (newMirrors) findMirrors(A);
+  const bool symmetric = options_.symmetricPart;
+  if (newMirrors) {
+    m.transposes.build(*A.getRowMap(), m.rowGid, m.rowPtr, m.colGid, m.comm);
+    for (std::size_t k = 0; k < m.keep.size(); ++k)
+      if (m.transposes.upper(k)) m.keep[k] = 0;
+  }
+  if (symmetric) m.transposes.gather(A, m.comm);
   CrsMatrix::local_inds_host_view_type inds;
   CrsMatrix::values_host_view_type vals;
   m.a.clear();
-  if (options_.symmetricPart) {
-    // This rank's values, then the mirrors other ranks hold (collective).
-    const std::size_t nnz = m.rowPtr.back();
-    m.rowValues.resize(nnz + m.mirrorsIn);
-    for (LO r = 0; r < nRows; ++r) {
-      A.getLocalRowView(r, inds, vals);
-      std::copy(vals.data(), vals.data() + vals.extent(0), m.rowValues.begin() + m.rowPtr[r]);
-    }
-    m.mirrorsOut.resize(m.mirrorsAsked.size());
-    for (std::size_t i = 0; i < m.mirrorsAsked.size(); ++i)
-      m.mirrorsOut[i] = m.mirrorsAsked[i] == Impl::kNoMirror ? 0.0 : m.rowValues[m.mirrorsAsked[i]];
-    MPI_Alltoallv(m.mirrorsOut.data(), m.askedCounts.data(), m.askedOffsets.data(), MPI_DOUBLE,
-                  m.rowValues.data() + nnz, m.askCounts.data(), m.askOffsets.data(), MPI_DOUBLE, m.comm);
-  }
   for (LO r = 0; r < nRows; ++r) {
     A.getLocalRowView(r, inds, vals);
     const std::size_t k0 = m.rowPtr[r], n = vals.extent(0);
@@ -274,12 +384,11 @@ bool MumpsSolver::keepNonzeros(const CrsMatrix& A, bool fresh, bool newMirrors) 
       bool any = false;
       for (std::size_t k = g; k < e; ++k) {
         double& x = v[k - g];
-        x = vals(k);
-        if (options_.symmetricPart && m.mirror[k0 + k] != Impl::kNoMirror) x = 0.5 * (x + m.rowValues[m.mirror[k0 + k]]);
-        any = any || (x != 0 && !(options_.symmetricPart && m.upper[k0 + k])) || m.keep[k0 + k];
+        x = symmetric ? m.transposes.symmetric(k0 + k) : vals(k);
+        any = any || (x != 0 && !(symmetric && m.transposes.upper(k0 + k))) || m.keep[k0 + k];
       }
       for (std::size_t k = g; k < e; ++k) {
-        if (options_.symmetricPart && m.upper[k0 + k]) continue;
+        if (symmetric && m.transposes.upper(k0 + k)) continue;
         if (!m.keep[k0 + k]) {
           if (!any) continue;
           m.keep[k0 + k] = 1, grew = true;
@@ -290,91 +399,6 @@ bool MumpsSolver::keepNonzeros(const CrsMatrix& A, bool fresh, bool newMirrors) 
     }
   }
   return grew;
-}
-
-// For each entry below the diagonal (row gid > column gid), where its
-// transpose is: an index into rowValues, this rank's entries first, then the
-// ones other ranks send (kNoMirror: not in the pattern, a zero). Entries above
-// the diagonal are marked and dropped (MUMPS reads one triangle of a
-// symmetric matrix). Once a pattern, collective: each row's entries sorted by
-// column for a binary search; the transposes in other ranks' rows asked of
-// their owners, who note which of their entries to send at each factorisation.
-void MumpsSolver::findMirrors(const CrsMatrix& A) {
-  Impl& m = *impl_;
-  const auto& rowMap = *A.getRowMap();
-  const std::size_t nnz = m.rowPtr.back();
-  const LO nRows = static_cast<LO>(m.rowGid.size());
-  auto& byColumn = m.byColumn;  // kept: fresh pages cost more than the sort
-  byColumn.resize(nnz);
-  for (std::size_t k = 0; k < nnz; ++k) byColumn[k] = {m.colGid[k], k};
-  for (LO r = 0; r < nRows; ++r) std::sort(byColumn.begin() + m.rowPtr[r], byColumn.begin() + m.rowPtr[r + 1]);
-  auto find = [&](LO row, GO col) {
-    const auto b = byColumn.begin() + m.rowPtr[row], e = byColumn.begin() + m.rowPtr[row + 1];
-    const auto it = std::lower_bound(b, e, std::make_pair(col, std::size_t(0)));
-    return it != e && it->first == col ? it->second : Impl::kNoMirror;
-  };
-  m.upper.assign(nnz, 0);
-  m.mirror.assign(nnz, Impl::kNoMirror);
-  std::vector<std::size_t> remote;  // entries whose transpose row is another rank's
-  std::vector<GO> remoteRows;
-  for (LO r = 0; r < nRows; ++r)
-    for (std::size_t k = m.rowPtr[r]; k < m.rowPtr[r + 1]; ++k) {
-      if (m.colGid[k] > m.rowGid[r]) {
-        m.upper[k] = 1, m.keep[k] = 0;
-        continue;
-      }
-      if (m.colGid[k] == m.rowGid[r]) continue;
-      const LO t = rowMap.getLocalElement(m.colGid[k]);
-      if (t != Teuchos::OrdinalTraits<LO>::invalid())
-        m.mirror[k] = find(t, m.rowGid[r]);
-      else
-        remote.push_back(k), remoteRows.push_back(m.colGid[k]);
-    }
-  // Ask each owner, grouped by rank, for (its row, our row) pairs.
-  // Their owners, looked up once per row: Tpetra 13.2's directory answered
-  // -1 for some ids of a list with repeats (the cyclic map in test_mumps).
-  std::vector<GO> rows(remoteRows);
-  std::sort(rows.begin(), rows.end());
-  rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
-  std::vector<int> rowOwner(rows.size());
-  std::vector<LO> rowLid(rows.size());
-  rowMap.getRemoteIndexList(Teuchos::ArrayView<const GO>(rows), Teuchos::arrayViewFromVector(rowOwner),
-                            Teuchos::arrayViewFromVector(rowLid));
-  std::vector<int> owner(remote.size());
-  for (std::size_t i = 0; i < remote.size(); ++i)
-    owner[i] = rowOwner[std::lower_bound(rows.begin(), rows.end(), remoteRows[i]) - rows.begin()];
-  std::vector<std::size_t> order(remote.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return owner[x] < owner[y]; });
-  m.askCounts.assign(m.size, 0), m.askOffsets.assign(m.size, 0);
-  std::vector<GO> asks(2 * remote.size());
-  for (std::size_t i = 0; i < order.size(); ++i) {
-    const std::size_t k = remote[order[i]];
-    ++m.askCounts[owner[order[i]]];
-    m.mirror[k] = nnz + i;
-    asks[2 * i] = m.colGid[k];
-    asks[2 * i + 1] = m.rowGid[std::upper_bound(m.rowPtr.begin(), m.rowPtr.end(), k) - m.rowPtr.begin() - 1];
-  }
-  for (int p = 1; p < m.size; ++p) m.askOffsets[p] = m.askOffsets[p - 1] + m.askCounts[p - 1];
-  m.askedCounts.assign(m.size, 0), m.askedOffsets.assign(m.size, 0);
-  MPI_Alltoall(m.askCounts.data(), 1, MPI_INT, m.askedCounts.data(), 1, MPI_INT, m.comm);
-  for (int p = 1; p < m.size; ++p) m.askedOffsets[p] = m.askedOffsets[p - 1] + m.askedCounts[p - 1];
-  const int asked = m.askedOffsets.back() + m.askedCounts.back();
-  std::vector<int> pairCounts(m.size), pairOffsets(m.size), pairsInCounts(m.size), pairsInOffsets(m.size);
-  for (int p = 0; p < m.size; ++p) {
-    pairCounts[p] = 2 * m.askCounts[p], pairOffsets[p] = 2 * m.askOffsets[p];
-    pairsInCounts[p] = 2 * m.askedCounts[p], pairsInOffsets[p] = 2 * m.askedOffsets[p];
-  }
-  std::vector<GO> pairsIn(2 * std::size_t(asked));
-  static_assert(sizeof(GO) == sizeof(long long), "global ids are long long");
-  MPI_Alltoallv(asks.data(), pairCounts.data(), pairOffsets.data(), MPI_LONG_LONG, pairsIn.data(),
-                pairsInCounts.data(), pairsInOffsets.data(), MPI_LONG_LONG, m.comm);
-  m.mirrorsAsked.resize(asked);
-  for (int i = 0; i < asked; ++i) {
-    const LO t = rowMap.getLocalElement(pairsIn[2 * i]);
-    m.mirrorsAsked[i] = t == Teuchos::OrdinalTraits<LO>::invalid() ? Impl::kNoMirror : find(t, pairsIn[2 * i + 1]);
-  }
-  m.mirrorsIn = remote.size();
 }
 
 void MumpsSolver::factor(const CrsMatrix& A) {

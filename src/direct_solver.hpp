@@ -167,7 +167,6 @@ class MumpsSolver {
   bool extractPattern(const CrsMatrix& A);  // true if this rank's pattern changed
   // The values MUMPS reads; true if the kept set grew. Collective with symmetricPart.
   bool keepNonzeros(const CrsMatrix& A, bool fresh, bool newMirrors);
-  void findMirrors(const CrsMatrix& A);  // symmetricPart: where each lower entry's transpose is (collective)
   void analyse(const CrsMatrix& A);
   void computeMetisOrdering();
   double analyseWith(MumpsOptions::Ordering ordering);  // one analysis; returns its estimated flops
