@@ -2,16 +2,16 @@
 # The accuracy studies of docs/accuracy.md: G1 and H1, every knob, with scripts/study.py,
 # and the pinch-roller nip's speed ratio with scripts/nip-accuracy.py.
 #   scripts/accuracy-studies.sh            (about 45 min on 2 cores; the G1 4x mesh
-#                                           alone takes ~18 min and is taken from
-#                                           out/g1-refine-4 when scripts/g1-refinement.sh
-#                                           has already run it)
+#                                           (46 s today) is taken from out/g1-refine-4
+#                                           when scripts/g1-refinement.sh has already
+#                                           run it)
 # Results: out/study-<case>/study.{csv,md,png}. Runs already done are reused.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 study() { /usr/bin/python3 scripts/study.py "$@"; }
 contact=capstan_force,peak_pressure,contact_width,max_ux,von_mises_max,sigma_yy_min,max_penetration
 
-# The 4x refined G1 (18 min) is taken from scripts/g1-refinement.sh if it has run it
+# The 4x refined G1 is taken from scripts/g1-refinement.sh if it has run it
 # (same scene, same settings).
 if [ -f out/g1-refine-4/summary.json ] && [ ! -f out/study-g1/runs/mesh-2/summary.json ]; then
   mkdir -p out/study-g1/runs && cp -r out/g1-refine-4 out/study-g1/runs/mesh-2
