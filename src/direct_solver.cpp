@@ -371,8 +371,9 @@ bool MumpsSolver::keepNonzeros(const CrsMatrix& A, bool fresh, bool newMirrors) 
   CrsMatrix::values_host_view_type vals;
   m.a.clear();
   for (LO r = 0; r < nRows; ++r) {
-    A.getLocalRowView(r, inds, vals);
-    const std::size_t k0 = m.rowPtr[r], n = vals.extent(0);
+    // The symmetric part's values are the transposes' (gathered above).
+    if (!symmetric) A.getLocalRowView(r, inds, vals);
+    const std::size_t k0 = m.rowPtr[r], n = m.rowPtr[r + 1] - k0;
     for (std::size_t g = 0; g < n;) {
       // With nonzeroNodeBlocks, a run of entries in one node's columns (its 3
       // unknowns, side by side in the row) is kept together once any is
