@@ -367,13 +367,30 @@ bool MumpsSolver::keepNonzeros(const CrsMatrix& A, bool fresh, bool newMirrors) 
       if (m.transposes.upper(k)) m.keep[k] = 0;
   }
   if (symmetric) m.transposes.gather(A, m.comm);
-  CrsMatrix::local_inds_host_view_type inds;
-  CrsMatrix::values_host_view_type vals;
   m.a.clear();
+  // The local matrix' arrays once, not a row view per row: the 3D drive's
+  // factorisations spent 2.2 ms each here, Tpetra's views counted in and out.
+  const auto local = A.getLocalMatrixHost();
+  const auto& rowStart = local.graph.row_map;
+  const auto& values = local.values;
+  if (!symmetric && !options_.nonzeroNodeBlocks) {
+    for (LO r = 0; r < nRows; ++r) {
+      const std::size_t k0 = m.rowPtr[r], n = m.rowPtr[r + 1] - k0, v0 = rowStart(r);
+      for (std::size_t k = 0; k < n; ++k) {
+        const double x = values(v0 + k);
+        char& kept = m.keep[k0 + k];
+        if (!kept) {
+          if (x == 0) continue;
+          kept = 1, grew = true;
+        }
+        m.a.push_back(x);
+      }
+    }
+    return grew;
+  }
   for (LO r = 0; r < nRows; ++r) {
     // The symmetric part's values are the transposes' (gathered above).
-    if (!symmetric) A.getLocalRowView(r, inds, vals);
-    const std::size_t k0 = m.rowPtr[r], n = m.rowPtr[r + 1] - k0;
+    const std::size_t k0 = m.rowPtr[r], n = m.rowPtr[r + 1] - k0, v0 = rowStart(r);
     for (std::size_t g = 0; g < n;) {
       // With nonzeroNodeBlocks, a run of entries in one node's columns (its 3
       // unknowns, side by side in the row) is kept together once any is
@@ -385,7 +402,7 @@ bool MumpsSolver::keepNonzeros(const CrsMatrix& A, bool fresh, bool newMirrors) 
       bool any = false;
       for (std::size_t k = g; k < e; ++k) {
         double& x = v[k - g];
-        x = symmetric ? m.transposes.symmetric(k0 + k) : vals(k);
+        x = symmetric ? m.transposes.symmetric(k0 + k) : values(v0 + k);
         any = any || (x != 0 && !(symmetric && m.transposes.upper(k0 + k))) || m.keep[k0 + k];
       }
       for (std::size_t k = g; k < e; ++k) {
