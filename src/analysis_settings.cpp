@@ -17,6 +17,11 @@ void AnalysisSettings::declare(Teuchos::ParameterList& analysis) {
   analysis.set("Upwind Order", 2,
                "Steady Rolling: the surface velocity along the rings as a first- (1) or second-order (2) "
                "upwind difference (docs/steady-rolling.md: 2 converges faster under refinement)");
+  const AnalysisSettings defaults;
+  analysis.set("Start Slip Scales", Teuchos::Array<double>(defaults.startSlipScales),
+               "Steady Rolling with Coulomb friction: the slip speed scales, as fractions of the capstan's surface "
+               "speed, of the Tanh laws the start from rest passes through before Coulomb, widest first "
+               "(docs/steady-rolling.md, \"Start from rest\", has the measurements that chose them)");
 }
 
 AnalysisSettings AnalysisSettings::parse(const Teuchos::ParameterList& analysis, const ParameterReader& r) {
@@ -25,6 +30,12 @@ AnalysisSettings AnalysisSettings::parse(const Teuchos::ParameterList& analysis,
   a.upwindOrder = analysis.get<int>("Upwind Order");
   if (a.upwindOrder != 1 && a.upwindOrder != 2)
     r.fail("Analysis/Upwind Order", "must be 1 or 2, got " + std::to_string(a.upwindOrder));
+  const auto& scales = analysis.get<Teuchos::Array<double>>("Start Slip Scales");
+  if (scales.empty()) r.fail("Analysis/Start Slip Scales", "needs at least one scale");
+  for (int k = 0; k < int(scales.size()); ++k)
+    if (!(std::isfinite(scales[k]) && scales[k] > 0 && (k == 0 || scales[k] < scales[k - 1])))
+      r.fail("Analysis/Start Slip Scales", "must be positive, finite and falling, widest first");
+  a.startSlipScales.assign(scales.begin(), scales.end());
   return a;
 }
 

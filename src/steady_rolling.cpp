@@ -11,18 +11,6 @@ namespace capstan {
 
 namespace {
 
-// Coulomb's start from rest: Tanh laws of these slip scales (as
-// Friction/Regularization) with the angular velocity free, each solve from the
-// last, then Coulomb with their tractions as its stick multipliers. The 3D
-// drive took 52 Newton iterations against 79 through friction at the held
-// angular velocity, the slice 22 against 28, the braked slice 25 against 28
-// and the Carter coating 22 against 32 (docs/steady-rolling.md, "Start from
-// rest"). One scale, 0.2 or 0.1: the braked slice's first solve failed and
-// its step was cut; 0.3: the drive 65. With one pass per stage (below),
-// {2, 0.4, 0.1} and {1, 0.1} took the drive's brake sweep from rest in 43-44
-// against 66 but the 8x256 braked slice in 24 against 20, the rest within 1-4
-// either way (docs/steady-rolling.md has the table).
-constexpr double kStartSlipScales[] = {0.02, 0.004};
 // Tanh and Arctan scenes whose slip speed scale lies below the first stage's
 // by more than this ratio start through their own law at the stages' scales,
 // which go on falling by this ratio to about the scene's: the drive under Tanh
@@ -156,14 +144,14 @@ std::vector<SteadyFrictionEffect*> SteadyRolling::frictionsStartedWide() const {
     auto* steady = dynamic_cast<SteadyFrictionEffect*>(f);
     if (!steady) continue;
     const double fraction = steady->sceneSlipFraction();
-    if (steady->augmented() || (fraction > 0 && fraction < kStartSlipScales[0] / kStartStageRatio))
+    if (steady->augmented() || (fraction > 0 && fraction < m_.scene.analysis.startSlipScales[0] / kStartStageRatio))
       widened.push_back(steady);
   }
   return widened;
 }
 
-std::vector<double> SteadyRolling::startSlipScales(const std::vector<SteadyFrictionEffect*>& widened) {
-  std::vector<double> scales(std::begin(kStartSlipScales), std::end(kStartSlipScales));
+std::vector<double> SteadyRolling::startSlipScales(const std::vector<SteadyFrictionEffect*>& widened) const {
+  std::vector<double> scales = m_.scene.analysis.startSlipScales;
   double narrowest = std::numeric_limits<double>::infinity();
   for (auto* f : widened)
     if (!f->augmented()) narrowest = std::min(narrowest, f->sceneSlipFraction());

@@ -42,8 +42,9 @@ class SteadyRolling {
   // first start stage: those the start widens.
   std::vector<SteadyFrictionEffect*> frictionsStartedWide() const;
   // The start stages' slip speed scales over the capstan's surface speed:
-  // kStartSlipScales, then on down to about the narrowest regularised law's.
-  static std::vector<double> startSlipScales(const std::vector<SteadyFrictionEffect*>& widened);
+  // Analysis/Start Slip Scales, then on down to about the narrowest
+  // regularised law's.
+  std::vector<double> startSlipScales(const std::vector<SteadyFrictionEffect*>& widened) const;
   // Omega free and the start stages: Tanh in Coulomb's place, a Tanh or Arctan
   // scene's law at the stage's scale where wider than its own; the scene's
   // laws again after them, Coulomb's multipliers their tractions if they converged.

@@ -179,6 +179,9 @@ TEST(SteadyScene, RejectsWhatItCannotSolve) {
   fails({"Supports/core/Axis Point={0.1,0,0}"}, "Supports/core/Axis Point");
   fails({"Supports/core/Axis Direction={0,1,1}"}, "Supports/core/Axis Direction");
   fails({"Analysis/Upwind Order=3"}, "Analysis/Upwind Order");
+  fails({"Analysis/Start Slip Scales={0.02, 0.04}"}, "Analysis/Start Slip Scales");  // widest first
+  fails({"Analysis/Start Slip Scales={0.02, 0}"}, "Analysis/Start Slip Scales");
+  EXPECT_EQ(steadyScene({"Analysis/Start Slip Scales={0.5}"}).analysis.startSlipScales, std::vector<double>{0.5});
   fails({"Analysis/Type=Steady"}, "Analysis/Type");
 }
 
