@@ -27,10 +27,10 @@ struct AnalysisSettings {
   // irregularly, scene by scene, so they were chosen by totals
   // (scripts/steady-start-scales.py): over 20 scenes (the eight steady ones,
   // twelve variants of the drive) 993 Newton iterations against 1,057 for
-  // {0.02, 0.004} and 1,010-1,121 for six other sets of three; over 14 hard
-  // cases 1,304 against 1,339. The drive 36 against 42, the 126k-dof drive 38
-  // (78 s) against 44 (106 s); with a tangential penalty of 1e-6 160 against
-  // 114 (docs/steady-rolling.md, "Start from rest").
+  // {0.02, 0.004} and 1,010-1,241 for eight other sets of three or four; over
+  // 14 hard cases 1,304 against 1,339. The drive 36 against 42, the 126k-dof
+  // drive 38 (77 s) against 44 (106 s); with a tangential penalty of 1e-6 160
+  // against 114 (docs/steady-rolling.md, "Start from rest").
   std::vector<double> startSlipScales = {0.06, 0.015, 0.004};
 
   bool steady() const { return type == Type::SteadyRolling; }
