@@ -444,7 +444,7 @@ NewtonResult AugmentationLoop::polish(double t, double start) {
   r.converged = true;
   r.residualNorm = start;
   r.residualHistory = {start};
-  const int linear = m_.newton->linearSolve(f, dx, 1e-12, /*keptPreconditioner=*/true);
+  const int linear = m_.newton->linearSolve(f, dx, 1e-12, NewtonSolver::Preconditioner::Kept);
   if (linear >= 0) {
     r.linearIterations = linear;
     trial.update(-1.0, dx, 1.0);

@@ -280,7 +280,7 @@ NewtonSolver::NewtonSolver(Assembly& assembly, const SolverSettings& settings)
     impl_->lows = factories.lows;
     auto prec = factories.prec;
     if (!prec.is_null() && impl_->lows->acceptsPreconditionerFactory()) {
-      // The predictor's one solve per step builds its own preconditioner;
+      // A solve with a preconditioner of its own (Own) builds one here;
       // Newton's may be kept across iterations (Solver/Preconditioner Reuse).
       impl_->lows->setPreconditionerFactory(
           rcp(new TimedPreconditionerFactory(prec, impl_->preconditionerSeconds, false)), "timed");
@@ -332,7 +332,16 @@ NewtonSolver::NewtonSolver(Assembly& assembly, const SolverSettings& settings)
 
 NewtonSolver::~NewtonSolver() = default;
 
-int NewtonSolver::linearSolve(const Vector& b, Vector& x, double tolerance, bool keptPreconditioner) {
+bool NewtonSolver::keepsFactorisation() const {
+  const auto& prec = impl_->prec;
+  return impl_->solver.preconditioner == SolverSettings::Preconditioner::LU && !impl_->newtonPrecFactory.is_null() &&
+         !prec.is_null() &&
+         (!prec->getUnspecifiedPrecOp().is_null() || !prec->getRightPrecOp().is_null() ||
+          !prec->getLeftPrecOp().is_null());
+}
+
+int NewtonSolver::linearSolve(const Vector& b, Vector& x, double tolerance, Preconditioner preconditioner,
+                              int maxIterations) {
   Kokkos::Timer timer;
   RCP<const Thyra::LinearOpBase<double>> W = impl_->W;
   auto space = impl_->model->get_x_space();
@@ -341,9 +350,11 @@ int NewtonSolver::linearSolve(const Vector& b, Vector& x, double tolerance, bool
   int iterations = -1;
   try {  // the factorisation (a direct solver's) happens here, and fails on a singular W
     RCP<Thyra::LinearOpWithSolveBase<double>> lows;
-    if (keptPreconditioner && !impl_->newtonPrecFactory.is_null()) {
-      impl_->newtonPrecFactory->initializePrec(Thyra::defaultLinearOpSource<double>(W), impl_->prec.get(),
-                                               Thyra::SUPPORT_SOLVE_UNSPECIFIED);
+    const bool asBuilt = preconditioner == Preconditioner::KeptAsBuilt && keepsFactorisation();
+    if (asBuilt || (preconditioner == Preconditioner::Kept && !impl_->newtonPrecFactory.is_null())) {
+      if (!asBuilt)
+        impl_->newtonPrecFactory->initializePrec(Thyra::defaultLinearOpSource<double>(W), impl_->prec.get(),
+                                                 Thyra::SUPPORT_SOLVE_UNSPECIFIED);
       lows = impl_->lows->createOp();
       impl_->lows->initializePreconditionedOp(Thyra::defaultLinearOpSource<double>(W), impl_->prec, lows.get(),
                                               Thyra::SUPPORT_SOLVE_UNSPECIFIED);
@@ -353,6 +364,10 @@ int NewtonSolver::linearSolve(const Vector& b, Vector& x, double tolerance, bool
     Thyra::SolveCriteria<double> criteria;
     criteria.solveMeasureType = Thyra::SolveMeasureType(Thyra::SOLVE_MEASURE_NORM_RESIDUAL, Thyra::SOLVE_MEASURE_NORM_RHS);
     criteria.requestedTol = tolerance;
+    if (maxIterations > 0) {
+      criteria.extraParameters = Teuchos::parameterList();
+      criteria.extraParameters->set("Maximum Iterations", maxIterations);
+    }
     const auto status = Thyra::solve<double>(*lows, Thyra::NOTRANS, *bt, xt.ptr(), Teuchos::constPtr(criteria));
     if (status.solveStatus == Thyra::SOLVE_STATUS_CONVERGED || status.solveStatus == Thyra::SOLVE_STATUS_UNKNOWN)
       iterations = status.extraParameters.is_null() ? 0 : status.extraParameters->get("Iteration Count", 0);

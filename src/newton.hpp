@@ -54,10 +54,18 @@ class NewtonSolver {
   // assembled it, and the configured solver with a preconditioner of its own
   // (x: initial guess in, solution out), to the relative residual `tolerance`
   // (Krylov solvers). Newton reassembles W before it next solves.
-  // `keptPreconditioner`: precondition with the one Newton keeps (Preconditioner
-  // Reuse; built now if none is) instead of a new one.
+  // `preconditioner`: Own (a new one), Kept (the one Newton keeps, Solver/
+  // Preconditioner Reuse; built now if none is or a rebuild is due) or
+  // KeptAsBuilt (the one Newton keeps as it is, however old: keepsFactorisation()
+  // says whether there is one). `maxIterations` > 0: at most that many Krylov
+  // iterations (fewer than the scene's limit).
   // Returns the Krylov iterations, or -1 if it failed.
-  int linearSolve(const Vector& b, Vector& x, double tolerance, bool keptPreconditioner = false);
+  enum class Preconditioner { Own, Kept, KeptAsBuilt };
+  int linearSolve(const Vector& b, Vector& x, double tolerance, Preconditioner preconditioner = Preconditioner::Own,
+                  int maxIterations = 0);
+  // Whether Newton keeps a factorisation built earlier (GMRES with the LU
+  // preconditioner), for KeptAsBuilt.
+  bool keepsFactorisation() const;
   // Newton's next linear solve builds a new preconditioner (with Solver/
   // Preconditioner Reuse = Adaptive it is otherwise kept while it works).
   void rebuildPreconditioner();

@@ -6,6 +6,22 @@
 
 namespace capstan {
 
+namespace {
+
+// The predictor's solve with the factorisation Newton kept from the last step
+// (GMRES with the LU preconditioner) instead of a new one: to this tolerance,
+// in at most this many iterations, else with a new one. G1 2x: 242 GMRES
+// iterations against 207 and 5 factorisations fewer, 1.34-1.50 -> 1.19-1.23 s
+// on 1 rank, 0.88 -> 0.83-0.86 s on 2; the same Newton iterations, forces
+// within 2e-12. To 1e-6 it took 15-17 iterations a step and gained half that.
+struct PredictorOnKept {
+  double tolerance;
+  int maxIterations;
+};
+constexpr PredictorOnKept kPredictorOnKept{1e-3, 30};
+
+}  // namespace
+
 double Predictors::firstGuess(double t0, double t, StepRecord& rec) {
   auto& assembly = *m_.assembly;
   Vector f(m_.u->getMap());
@@ -147,9 +163,17 @@ void Predictors::tangent(double t0, double t1, double bare, StepRecord& rec) {
   }
   // A first guess: 1e-6 is plenty (Newton corrects it); a tighter tolerance
   // on a nearly steady step, where the right-hand side is at round-off, ran
-  // GMRES to its limit.
-  const int its = m_.newton->linearSolve(rhs, du, std::max(1e-6, m_.scene.solver.linearTolerance));
+  // GMRES to its limit. With the factorisation Newton kept from the last step
+  // where there is one (kPredictorOnKept), else with a new one.
+  int its = -1, spent = 0;
+  if (m_.newton->keepsFactorisation()) {
+    its = m_.newton->linearSolve(rhs, du, std::max(kPredictorOnKept.tolerance, m_.scene.solver.linearTolerance),
+                                 NewtonSolver::Preconditioner::KeptAsBuilt, kPredictorOnKept.maxIterations);
+    if (its < 0) spent = kPredictorOnKept.maxIterations, du.putScalar(0.0);
+  }
+  if (its < 0) its = m_.newton->linearSolve(rhs, du, std::max(1e-6, m_.scene.solver.linearTolerance));
   for (const auto& e : assembly.effects()) e->setPredicting(false);
+  rec.linear += spent;
   if (its < 0) return;  // keep the plain guess
   rec.linear += its;
   // The linear response can overshoot where contact or large strain makes the
