@@ -180,6 +180,46 @@ TEST(Assembly, PredictorLoadMatchesMatrixAndDifferences) {
     }
 }
 
+// NewtonSolver::linearSolve with the factorisation Newton keeps (GMRES with the
+// LU preconditioner): Kept builds it, KeptAsBuilt reuses it at another state
+// without a rebuild and still solves that state's system, and the iteration
+// cap makes a stale factorisation's tight solve fail instead of run on.
+TEST(NewtonSolver, KeptFactorisationAsBuilt) {
+  Scene scene = boxScene();
+  scene.solver.linearSolver = SolverSettings::LinearSolver::GMRES;
+  scene.solver.preconditioner = SolverSettings::Preconditioner::LU;
+  BoxProblem problem(scene, 1.0);
+  auto& [sc, mesh, assembly, newton, u, f] = problem;
+  auto W = newton.matrix();
+  ASSERT_TRUE(assembly.evaluate(u, &f, W.get()));
+  EXPECT_FALSE(newton.keepsFactorisation());
+  Vector x(assembly.dofMap());
+  EXPECT_GE(newton.linearSolve(f, x, 1e-10, NewtonSolver::Preconditioner::Kept), 0);
+  ASSERT_TRUE(newton.keepsFactorisation());
+  const int builds = newton.preconditionerBuilds();
+
+  // Another state: its own matrix, solved on the kept factorisation.
+  Vector u2(u, Teuchos::Copy);
+  setField(mesh, u2, 3.0);
+  assembly.applyConstraints(u2, 0.0);
+  ASSERT_TRUE(assembly.evaluate(u2, &f, W.get()));
+  Vector xKept(assembly.dofMap()), xOwn(assembly.dofMap()), r(assembly.dofMap());
+  const int kept = newton.linearSolve(f, xKept, 1e-10, NewtonSolver::Preconditioner::KeptAsBuilt, 200);
+  EXPECT_GT(kept, 1);  // stale: more than the one iteration of an exact factorisation
+  EXPECT_EQ(newton.preconditionerBuilds(), builds);
+  W->apply(xKept, r);
+  r.update(-1.0, f, 1.0);
+  EXPECT_LT(r.norm2(), 1e-9 * f.norm2());
+  ASSERT_TRUE(assembly.evaluate(u2, &f, W.get()));
+  EXPECT_GE(newton.linearSolve(f, xOwn, 1e-10), 0);
+  xOwn.update(-1.0, xKept, 1.0);
+  EXPECT_LT(xOwn.normInf(), 1e-7 * xKept.normInf());
+
+  // The cap: one iteration cannot reach 1e-12 on a stale factorisation.
+  Vector xCapped(assembly.dofMap());
+  EXPECT_EQ(newton.linearSolve(f, xCapped, 1e-12, NewtonSolver::Preconditioner::KeptAsBuilt, 1), -1);
+}
+
 // evaluate()'s phases are timed in turn within its total.
 TEST(Assembly, PhaseSecondsAddUpWithinTheTotal) {
   BoxProblem problem(boxScene(), 1.0);
