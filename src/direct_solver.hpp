@@ -136,6 +136,8 @@ class MumpsSolver {
   // Solves A x = b for every column of b (b on A's range map, x on its domain
   // map, as many columns as b). Throws std::logic_error if nothing is factored.
   void solve(const MultiVector& b, MultiVector& x);
+  // Whether a factorisation is there to solve with.
+  bool factored() const { return factored_; }
 
   // Counters (since construction).
   int numAnalyses() const { return numAnalyses_; }

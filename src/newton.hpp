@@ -73,10 +73,11 @@ class NewtonSolver {
   RCP<FEMatrix> matrix() const;
   // z = K~^-1 r, an approximate inverse of matrix() as its values are now:
   // Newton's preconditioner (built if it has none yet), or, for a direct
-  // solver, a factorisation made once here. Building it counts as linear
-  // solve time (set-up as preconditioner set-up); its applications are the
-  // caller's to time.
-  std::function<void(const Vector& r, Vector& z)> approximateInverse();
+  // solver, a factorisation made once here, or with `afterNewton` (matrix()
+  // assembled where a Newton solve just converged) the one Newton made last,
+  // one Newton step before. Building it counts as linear solve time (set-up
+  // as preconditioner set-up); its applications are the caller's to time.
+  std::function<void(const Vector& r, Vector& z)> approximateInverse(bool afterNewton = false);
   double linearSolveSeconds() const;
   // The part of linearSolveSeconds() spent setting up preconditioners.
   double preconditionerSeconds() const;

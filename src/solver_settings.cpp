@@ -72,6 +72,11 @@ void SolverSettings::declare(ParameterList& sol) {
           "spurious pressure modes), Diagonal ((eps V)^-1 alone), or Auto (Laplacian with Krylov "
           "linear solves, Diagonal with a direct solver, whose exact K^-1 leaves it little to gain). "
           "The same answer either way");
+  sol.set("Pressure Step Factorisation", std::string("Newton's"),
+          "With a direct solver, the saddle-point step after a Newton solve preconditions its Krylov solve with: "
+          "Newton's (its last factorisation, the tangent one Newton step before the converged state) | New (one "
+          "made at the converged state). Newton's: the steady drive 0.86 against 1.04 s, the quasi-static drive "
+          "9.05 against 9.77 s, the same Newton iterations (docs/performance.md, \"Defaults and why\")");
   sol.set("Pressure Acceleration Depth", 5,
           "Anderson acceleration depth of the pressure loop (0 = plain pbar <- p(x))");
   sol.set("Minimum Solve Penalty", -1.0,
@@ -151,6 +156,9 @@ SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterRe
   s.pressureStepSchur = r.choice(sol, at, "Pressure Step Schur",
                                  std::vector<std::pair<const char*, Schur>>{
                                      {"Auto", Schur::Auto}, {"Laplacian", Schur::Laplacian}, {"Diagonal", Schur::Diagonal}});
+  s.pressureStepOnNewtonsFactors =
+      r.choice(sol, at, "Pressure Step Factorisation",
+               std::vector<std::pair<const char*, bool>>{{"Newton's", true}, {"New", false}});
   s.pressureAccelerationDepth = r.atLeast(sol, at, "Pressure Acceleration Depth", 0);
   // Automatic: the fastest on G1 for each update (docs/performance.md,
   // "Defaults and why"): 3e-2 with the saddle-point step, 1e-2 with Anderson;

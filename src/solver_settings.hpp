@@ -49,6 +49,9 @@ struct SolverSettings {
   bool monolithic = false;
   bool monolithicIfExact = false;
   Schur pressureStepSchur{};
+  // With a direct solver, the saddle-point step after a Newton solve
+  // preconditions with Newton's last factorisation (false: a new one).
+  bool pressureStepOnNewtonsFactors = true;
   int pressureAccelerationDepth = 0;
   double minimumSolvePenalty = 0;  // resolved: > 0
   // Automatic (-1): Model lowers it to kMonolithicSolvePenalty where the loop
