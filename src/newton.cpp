@@ -25,6 +25,12 @@ namespace {
 
 using ConverterT = Thyra::TpetraOperatorVectorExtraction<double>;
 
+// Whether a preconditioner has been built (holds an operator on some side).
+bool built(const Thyra::PreconditionerBase<double>& prec) {
+  return !prec.getUnspecifiedPrecOp().is_null() || !prec.getRightPrecOp().is_null() ||
+         !prec.getLeftPrecOp().is_null();
+}
+
 // Times the preconditioner set-up (ILU factorisation, MueLu hierarchy) apart
 // from the Krylov iterations, for summary.json's timing breakdown: a thin
 // wrapper around the factory Stratimikos configured.
@@ -42,9 +48,7 @@ class TimedPreconditionerFactory : public Thyra::PreconditionerFactoryBase<doubl
   RCP<Thyra::PreconditionerBase<double>> createPrec() const override { return inner_->createPrec(); }
   void initializePrec(const RCP<const Thyra::LinearOpSourceBase<double>>& src, Thyra::PreconditionerBase<double>* prec,
                       const Thyra::ESupportSolveUse use) const override {
-    const bool built = !prec->getUnspecifiedPrecOp().is_null() || !prec->getRightPrecOp().is_null() ||
-                       !prec->getLeftPrecOp().is_null();
-    if (lagged_ && built && !rebuild_) return;
+    if (lagged_ && built(*prec) && !rebuild_) return;
     Kokkos::Timer timer;
     inner_->initializePrec(src, prec, use);
     seconds_ += timer.seconds();
@@ -336,9 +340,7 @@ NewtonSolver::~NewtonSolver() = default;
 bool NewtonSolver::keepsFactorisation() const {
   const auto& prec = impl_->prec;
   return impl_->solver.preconditioner == SolverSettings::Preconditioner::LU && !impl_->newtonPrecFactory.is_null() &&
-         !prec.is_null() &&
-         (!prec->getUnspecifiedPrecOp().is_null() || !prec->getRightPrecOp().is_null() ||
-          !prec->getLeftPrecOp().is_null());
+         !prec.is_null() && built(*prec);
 }
 
 int NewtonSolver::linearSolve(const Vector& b, Vector& x, double tolerance, Preconditioner preconditioner,
