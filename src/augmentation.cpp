@@ -369,7 +369,8 @@ bool AugmentationLoop::saddlePointPressureStep(double t, Vector& f, bool volumeM
   PressureStep::Result step;
   const auto stepStart = Clock::now();
   try {
-    step = m_.pressureStep->solve(*W, m_.newton->approximateInverse(!monolithic && m_.scene.solver.pressureStepOnNewtonsFactors), f,
+    const bool onNewtonsFactors = !monolithic && m_.scene.solver.pressureStepOnNewtonsFactors;
+    step = m_.pressureStep->solve(*W, m_.newton->approximateInverse(onNewtonsFactors), f,
                                   monolithic ? kMonolithicStepTolerance : kPressureStepTolerance, volumeTarget,
                                   m_.scene.solver.maxLinearIterations, dx, pressureStepDmu_);
   } catch (const std::exception&) {  // e.g. a preconditioner that cannot be built: a plain pass

@@ -171,13 +171,14 @@ void TransposeEntries::build(const Map& rowMap, const std::vector<GO>& rowGid, c
 
 void TransposeEntries::gather(const CrsMatrix& A, MPI_Comm comm) {
   values_.resize(local_ + remoteCount_);
-  CrsMatrix::local_inds_host_view_type inds;
-  CrsMatrix::values_host_view_type vals;
+  // The local matrix' arrays once, not a row view per row (as keepNonzeros).
+  const auto local = A.getLocalMatrixHost();
+  const auto& rowStart = local.graph.row_map;
   std::size_t k = 0;
   for (LO r = 0; r < LO(A.getNodeNumRows()); ++r) {
-    A.getLocalRowView(r, inds, vals);
-    std::copy(vals.data(), vals.data() + vals.extent(0), values_.begin() + k);
-    k += vals.extent(0);
+    const std::size_t b = rowStart(r), e = rowStart(r + 1);
+    std::copy(local.values.data() + b, local.values.data() + e, values_.begin() + k);
+    k += e - b;
   }
   sent_.resize(asked_.size());
   for (std::size_t i = 0; i < asked_.size(); ++i) sent_[i] = asked_[i] == kNone ? 0.0 : values_[asked_[i]];
