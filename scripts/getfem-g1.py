@@ -56,6 +56,11 @@ Usage (Debian: apt-get install -y python3-getfem; run with /usr/bin/python3):
       wall vs capstan's summary.json timing.total; process = whole process wall time
       (python start + import getfem vs capstan start-up, Trilinos init and output files).
       --ranks N runs capstan on N MPI ranks (mpiexec; the GetFEM run stays serial).
+  --cpu-kernels unsets OPENBLAS_CORETYPE and OPENBLAS_L2_SIZE for both codes, so that
+      OpenBLAS picks its kernels from the CPU (some machines set them to an older kernel
+      set, e.g. Haswell's AVX2 on an AVX-512 CPU, because older OpenBLAS builds computed
+      wrong results there: compare the forces with a run without it). The header line
+      names the kernels in use.
   --blas-dir DIR puts DIR first on LD_LIBRARY_PATH (of both codes with --compare), e.g.
       apt-get download libopenblas0-serial && dpkg -x libopenblas0-serial_*.deb ob
       --blas-dir ob/usr/lib/x86_64-linux-gnu/openblas-serial
@@ -241,8 +246,14 @@ def run_capstan(binary, scene, refine, outdir, args_blas_dir=None, ranks=1):
     return wall, s
 
 
+CPU_KERNELS = False  # --cpu-kernels: OpenBLAS' own choice of kernels for both codes
+
+
 def child_env(blas_dir):
     env = dict(os.environ)
+    if CPU_KERNELS:
+        env.pop("OPENBLAS_CORETYPE", None)
+        env.pop("OPENBLAS_L2_SIZE", None)
     if blas_dir:
         env["LD_LIBRARY_PATH"] = os.path.abspath(blas_dir) + (
             ":" + env["LD_LIBRARY_PATH"] if env.get("LD_LIBRARY_PATH") else "")
@@ -265,11 +276,23 @@ def compare(args, refines):
         compare_in(args, refines, tmp)
 
 
+def openblas_kernels(blas_dir):
+    """The kernel set OpenBLAS picks in the children's environment ('-': not OpenBLAS)."""
+    code = ("import ctypes\ntry:\n l = ctypes.CDLL('libopenblas.so.0')\n"
+            " l.openblas_get_corename.restype = ctypes.c_char_p\n"
+            " print(l.openblas_get_corename().decode())\nexcept Exception:\n print('-')")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         env=child_env(blas_dir)).stdout.strip()
+    return out or "-"
+
+
 def compare_in(args, refines, tmp):
+    env = child_env(args.blas_dir)
     print("capstan: %s on %d rank(s); GetFEM: %s; Newton rtol %g; BLAS dir for both: %s; "
-          "OMP_NUM_THREADS=%s" % (args.compare, args.ranks, sys.executable, args.rtol,
-                                  args.blas_dir or "system default",
-                                  os.environ.get("OMP_NUM_THREADS")), flush=True)
+          "OpenBLAS kernels: %s (OPENBLAS_CORETYPE=%s); OMP_NUM_THREADS=%s"
+          % (args.compare, args.ranks, sys.executable, args.rtol, args.blas_dir or "system default",
+             openblas_kernels(args.blas_dir), env.get("OPENBLAS_CORETYPE", "unset"),
+             os.environ.get("OMP_NUM_THREADS")), flush=True)
     for k in refines:
         rows = []
         for rnd in range(args.rounds):
@@ -329,7 +352,12 @@ def main():
                     help="directory with a libblas.so.3/liblapack.so.3 put first on "
                          "LD_LIBRARY_PATH of both codes (e.g. an extracted "
                          "libopenblas0-serial); default: the system's BLAS alternative")
+    ap.add_argument("--cpu-kernels", action="store_true",
+                    help="unset OPENBLAS_CORETYPE and OPENBLAS_L2_SIZE for both codes "
+                         "(OpenBLAS' own choice of kernels for the CPU)")
     args = ap.parse_args()
+    global CPU_KERNELS
+    CPU_KERNELS = args.cpu_kernels
     ensure_getfem()
     if args.blas_dir and not args.compare and os.environ.get("G1_BLAS_SET") != "1":
         env = child_env(args.blas_dir)

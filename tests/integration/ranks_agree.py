@@ -19,6 +19,9 @@ so an exact and a preconditioned solve may take a step more or less). And G1 wit
 14 x 4), every summary figure as on 1 rank. Auto on 2 ranks, one step: G1 with 32 layers
 (16 a rank) is split into slabs (56 faces cut), with 30 layers (15 a rank) by METIS (which
 here finds a plane too).
+Repeatability (docs/performance.md, "Repeatability"): G1 run again on 1 rank and on 2
+(below 2,000 unknowns MUMPS factors on rank 0 alone) gives a summary.json equal to the
+first run's to the last digit, timings and memory aside.
 """
 import os
 import sys
@@ -30,6 +33,7 @@ from capstan_test import Test, by_reference_coordinates, read_fields, summary_fi
 TOL = 1e-8
 T = Test("ranks_agree", __doc__)
 serial = {}  # scene -> its 1-rank summary
+distributed = {}  # scene -> its 2-rank summary
 
 for name in ("uniaxial.xml", "shear.xml", "seed/g1.xml", "seed/h1.xml", "seed/h5.xml"):
     scene = T.input(name)
@@ -46,7 +50,7 @@ for name in ("uniaxial.xml", "shear.xml", "seed/g1.xml", "seed/h1.xml", "seed/h5
     if len(results) < 2:
         continue
     (s1, out1), (s2, out2) = results[1], results[2]
-    serial[name] = s1
+    serial[name], distributed[name] = s1, s2
     T.check(len(s1["steps"]) == len(s2["steps"]),
             f"{name}: {len(s1['steps'])} steps on 1 rank, {len(s2['steps'])} on 2")
     sizes = ("nodes", "elements", "dofs", "contact_faces")
@@ -125,5 +129,27 @@ for layers, want in ((32, "Slabs"), (30, "METIS")):
     T.check(s["converged"] is True and s["mesh"]["partition"] == want and (cut == 14 * 4 or want == "METIS"),
             f"G1 with {layers} layers, Auto on 2 ranks: mesh.partition {s['mesh']['partition']!r} ({want}), "
             f"cut_faces {cut}, converged {s['converged']}")
+
+
+
+def without_timings(d):
+    """summary.json less what a run measures of itself (seconds, memory, the build)."""
+    if isinstance(d, dict):
+        return {k: without_timings(v) for k, v in d.items()
+                if k not in ("timing", "memory", "wall_seconds", "seconds", "version")}
+    if isinstance(d, list):
+        return [without_timings(x) for x in d]
+    return d
+
+
+for ranks, first in ((1, serial), (2, distributed)):
+    p, s, out = T.run_scene(g1, f"g1-again-{ranks}", ranks=ranks)
+    if s is None or "seed/g1.xml" not in first:
+        T.check(False, f"G1 again on {ranks} rank(s): no summary.json (or no first run)")
+        continue
+    a, b = without_timings(first["seed/g1.xml"]), without_timings(s)
+    differing = [k for k in a if a[k] != b.get(k)]
+    T.check(a == b, f"G1 again on {ranks} rank(s): summary.json equal to the first run's, timings aside "
+                    f"(differing: {differing})")
 
 T.finish()
