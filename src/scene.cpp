@@ -13,6 +13,7 @@
 #include <filesystem>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
@@ -203,6 +204,16 @@ bool readDouble(const std::string& text, double& x) {
   char* end = nullptr;
   x = std::strtod(t.c_str(), &end);
   return end == t.c_str() + t.size() && errno != ERANGE && std::isfinite(x);
+}
+
+// As the scene files spell a bool (Teuchos' XML: true/false, also 1/0),
+// whatever the case; anything else is bad input, not false.
+bool readBool(const std::string& text) {
+  std::string t = text;
+  for (auto& c : t) c = char(std::tolower(static_cast<unsigned char>(c)));
+  if (t == "true" || t == "1") return true;
+  if (t == "false" || t == "0") return false;
+  throw std::invalid_argument("not a bool");
 }
 
 bool readInt(const std::string& text, int& x) {
@@ -469,7 +480,7 @@ void applySet(ParameterList& scene, const ParameterList& valid, const std::strin
     };
     if (t == typeid(double)) list->set(name, number(0.0));
     else if (t == typeid(int)) list->set(name, number(0));
-    else if (t == typeid(bool)) list->set(name, value == "true" || value == "1");
+    else if (t == typeid(bool)) list->set(name, readBool(value));
     else if (t == typeid(std::string)) list->set(name, value);
     else if (t == typeid(Array<double>) || t == typeid(Array<int>)) {
       Array<double> ad;

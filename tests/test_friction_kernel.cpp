@@ -100,7 +100,9 @@ TEST_P(FrictionTangent, MatchesCentralDifferences) {
       if (k.expectState) {
         EXPECT_EQ(pts[q].state, k.expectState) << k.name << " point " << q;
       }
-      if (k.held) EXPECT_NEAR(tmag, k.mu * pts[q].normal, 1e-12 * k.mu * pts[q].normal) << k.name << ": at the cone";
+      if (k.held) {
+        EXPECT_NEAR(tmag, k.mu * pts[q].normal, 1e-12 * k.mu * pts[q].normal) << k.name << ": at the cone";
+      }
       // Coulomb: central differences must not straddle the stick/slip switch.
       if (k.law == FrictionLaw::Coulomb && pts[q].state == 1)
         nearSwitch = nearSwitch || tmag > k.mu * pts[q].normal * (1 - 1e-4);

@@ -237,6 +237,8 @@ f = scene_file("one-cell.xml", edited(('value="{14, 4, 6}"', 'value="{1, 1, 1}"'
 case("one cell on 2 ranks", f, [f, "Mesh/Cells"], ranks=2)
 case("--set: 1e999", good, [good, "Material/c"], args=["--set", "Material/c=1e999"])
 case("--set: list with a word", good, [good, "Mesh/Cells"], args=["--set", "Mesh/Cells={4,two,2}"])
+case("--set: a bool that is neither", good, [good, "Output/Write Fields", "bool"],
+     args=["--set", "Output/Write Fields=maybe"])
 case("--set: 2 ranks, negative radius", good, [good, f"{C}/Radius"], args=["--set", f"{C}/Radius=-1"], ranks=2)
 
 # --- a capstan that can never touch its faces: warning, the run goes on ------------------------
