@@ -399,6 +399,15 @@ def main():
             bx.plot(m[:, 0], m[:, 3], "-", color="0.6", lw=0.8, zorder=1)
             bx.plot(m[~sl, 0], m[~sl, 3], **st_kw)
             bx.plot(m[sl, 0], m[sl, 3], **sl_kw)
+            # The stick zone's shear less its node-to-node alternation (the outer elements'
+            # Q1P0 pressure checkerboard, held by the sticking nodes: docs/steady-rolling.md).
+            fs, ft = [], []
+            for i in range(1, len(m) - 1):
+                if not (sl[i - 1] or sl[i] or sl[i + 1]):
+                    fs.append(m[i, 0]), ft.append(0.25 * (m[i - 1, 3] + 2 * m[i, 3] + m[i + 1, 3]))
+            if len(fs) > 1:
+                bx.plot(fs, ft, "-", color="tab:blue", lw=1.8, alpha=0.8,
+                        label="stick shear, node-to-node alternation\nfiltered out (1/4, 1/2, 1/4)")
             if href and mu:
                 a, p0 = href
                 if braked:

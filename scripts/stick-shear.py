@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """How much a steady run's friction shear alternates from face to face in its stick zone
-(docs/steady-rolling.md, "Open"):
+(docs/steady-rolling.md, "In the stick zone the shear alternates from node to node"):
 
     scripts/stick-shear.py RUN_DIR [RUN_DIR ...] [--mu 0.8]
 
@@ -11,7 +11,18 @@ traction along the ring's direction), t_f - (t_f-1 + t_f+1) / 2, and of the pres
 element under it. Printed per run: the stick faces counted, the shear's rms and largest
 second difference over mu p_max (p_max the largest contact pressure), the element
 pressures' rms, and the correlation of the two.
+
+Then, per run, the nodes (nip.csv's rows of the last step, matched to the mesh's surface
+nodes by s and z): a sticking node's friction shear against the jump of pressure across it,
+p(element behind) - p(element ahead) of the two outer-layer elements that share it. Under
+Q1P0 a pressure jump pushes the node along the ring (by the jump times half the outer
+element's thickness per unit length), and in the stick zone the shear is what holds the
+node: the table gives the correlation of the two's alternating parts (each less its
+1/4, 1/2, 1/4 average over the node and its ring neighbours) and their ratio. The capstan's
+axis, radius and turning sense come from the run's scene (summary.json's "scene", read
+relative to the current directory, or --scene).
 """
+import xml.etree.ElementTree as ET
 import argparse
 import os
 
@@ -21,6 +32,7 @@ import numpy as np
 ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
 ap.add_argument("runs", nargs="+")
 ap.add_argument("--mu", type=float, default=0.8, help="the friction coefficient (scales the figures)")
+ap.add_argument("--scene", help="the runs' scene (default: summary.json's, relative to the current directory)")
 args = ap.parse_args()
 
 
@@ -65,3 +77,92 @@ for run in args.runs:
     corr = np.corrcoef(dt, dp)[0, 1] if dp.std() > 0 and dt.std() > 0 else float("nan")
     print(f"| {run} | {len(dt)} | {np.sqrt(np.mean(dt**2)) / scale:.3f} | {np.abs(dt).max() / scale:.3f} | "
           f"{np.sqrt(np.mean(dp**2)):.4f} | {corr:+.2f} |")
+
+
+def capstan_of(scene_path):
+    """(axis point, axis direction, radius, sense) of the scene's first capstan."""
+    root = ET.parse(scene_path).getroot()
+    mesh = {e.get("name"): e.get("value") for e in [m for m in root if m.get("name") == "Mesh"][0] if e.tag == "Parameter"}
+    caps = [e for e in root if e.get("name") == "Capstans"][0][0]
+    val = {e.get("name"): e.get("value") for e in caps if e.tag == "Parameter"}
+    vec = lambda t: np.array([float(v) for v in t.strip("{} ").split(",")])
+    b = vec(val["Axis Direction"])
+    return vec(val["Axis Point"]), b / np.linalg.norm(b), float(val["Radius"]), \
+        1.0 if float(val.get("Angular Velocity", "1")) >= 0 else -1.0, vec(mesh.get("Center", "{0, 0, 0}"))
+
+
+def node_jumps(run):
+    """Per sticking node with two sticking ring neighbours: (shear, pressure jump)."""
+    import csv
+    import json
+    with open(os.path.join(run, "summary.json")) as f:
+        scene = args.scene or json.load(f)["scene"]
+    a, b, radius, sense, roller = capstan_of(scene)
+    with h5py.File(os.path.join(run, "fields.h5"), "r") as f:
+        step = f["steps"][sorted(f["steps"].keys())[-1]]
+        x = step["coordinates"][:]
+        X = x - step["nodes/displacement"][:]
+        hexes = f["mesh/hexahedra"][:]
+        p = step["elements/pressure"][:, 0]
+    with open(os.path.join(run, "nip.csv")) as f:
+        rows = list(csv.DictReader(f))
+    last = max(int(r["step"]) for r in rows)
+    nodes = {}
+    for r in rows:
+        if int(r["step"]) == last:
+            nodes[(round(float(r["s"]), 7), round(float(r["z"]), 7))] = (float(r["shear"]), r["state"])
+    # The mesh's surface nodes (outer radius about its z axis), their s and z as nip.csv's.
+    rc = np.round(np.hypot(*X[hexes].mean(axis=1)[:, :2].T), 6)
+    centre = x[hexes].mean(axis=1)  # where the elements are now
+    outer = np.where(rc == rc.max())[0]
+    rn = np.hypot(X[:, 0], X[:, 1])
+    surface = np.unique(hexes[outer])
+    surface = surface[np.abs(rn[surface] - rn[surface].max()) < 1e-9]
+    n0 = roller - a
+    n0 = n0 - b * (n0 @ b)
+    n0 /= np.linalg.norm(n0)
+    d = x[surface] - a
+    e = d - np.outer(d @ b, b)
+    e /= np.linalg.norm(e, axis=1)[:, None]
+    phi = np.arctan2(np.cross(n0, e) @ b, e @ n0)
+    s_n, z_n = sense * radius * phi, d @ b
+    owner = {}
+    for k in outer:
+        for n in hexes[k]:
+            owner.setdefault(int(n), []).append(int(k))
+    out = []
+    zs = sorted({z for _, z in nodes})
+    for z in zs:
+        ring = sorted((s_, v) for (s_, z_), v in nodes.items() if z_ == z)
+        pts = []
+        for s_, (shear, state) in ring:
+            k = int(np.argmin((s_n - s_) ** 2 + (z_n - z) ** 2))
+            n = int(surface[k])
+            els = owner.get(n, [])
+            # the two outer elements beside the node at this z (nearest in z)
+            els = sorted(els, key=lambda el: abs(((centre[el] - a) @ b) - z))[:4]
+            ang = {el: np.arctan2(np.cross(n0, centre[el] - a) @ b, (centre[el] - a) @ n0) for el in els}
+            behind = [el for el in els if sense * ang[el] < sense * phi[k]]
+            ahead = [el for el in els if sense * ang[el] > sense * phi[k]]
+            jump = np.mean(p[behind]) - np.mean(p[ahead]) if behind and ahead else np.nan
+            pts.append((shear, jump, state))
+        for i in range(1, len(pts) - 1):
+            if all(pts[j][2] == "stick" for j in (i - 1, i, i + 1)) and not np.isnan(
+                    [pts[j][1] for j in (i - 1, i, i + 1)]).any():
+                alt = lambda j: pts[i][j] - 0.25 * (pts[i - 1][j] + 2 * pts[i][j] + pts[i + 1][j])
+                out.append((alt(0), alt(1)))
+    return np.array(out)
+
+
+print()
+print("| run | sticking nodes | shear alternation rms [MPa] | pressure-jump alternation rms [MPa] | correlation | shear / jump |")
+print("|---|---|---|---|---|---|")
+for run in args.runs:
+    a_ = node_jumps(run)
+    if len(a_) < 3:
+        print(f"| {run} | {len(a_)} | - | - | - | - |")
+        continue
+    t, j = a_[:, 0], a_[:, 1]
+    corr = np.corrcoef(t, j)[0, 1]
+    print(f"| {run} | {len(a_)} | {np.sqrt(np.mean(t**2)):.4f} | {np.sqrt(np.mean(j**2)):.4f} | {corr:+.3f} | "
+          f"{np.polyfit(j, t, 1)[0]:.2f} |")
