@@ -26,8 +26,10 @@ scripts/steady-phases.py on the steady slice (2 phases): phase 0 is the scene's 
 mesh, phase 1 another, and phases.csv's mean is the two runs' mean; a scene without a
 fine sector is refused.
 
-scripts/stick-shear.py on the steady slice at 8x256: one table row, stick faces counted, the
-shear's alternation a fraction of mu p_max (rms at most the largest).
+scripts/stick-shear.py on the steady slice at 8x256: one row in each table, stick faces counted, the
+shear's alternation a fraction of mu p_max (rms at most the largest); at the sticking nodes the
+shear's alternation follows the jump of the outer elements' pressure across each node (Q1P0's
+checkerboard: correlation below -0.95).
 """
 import csv
 import json
@@ -175,9 +177,13 @@ T.run_scene(T.input("pinch-roller-slice-steady.xml"), "stick-shear", sets=["Mesh
 p = subprocess.run([sys.executable, os.path.join(scripts, "stick-shear.py"), T.path("stick-shear")],
                    capture_output=True, text=True, timeout=60)
 row = [line.split("|")[1:-1] for line in p.stdout.splitlines() if line.startswith("| " + T.path("stick-shear"))]
-if p.returncode == 0 and len(row) == 1 and " - " not in row[0]:
+if p.returncode == 0 and len(row) == 2 and " - " not in row[0] + row[1]:
     faces, rms, largest = int(row[0][1]), float(row[0][2]), float(row[0][3])
     T.check(faces > 0 and 0 < rms <= largest < 1, f"stick-shear.py: {faces} stick faces, rms {rms}, largest {largest}")
+    nodes, corr, ratio = int(row[1][1]), float(row[1][4]), float(row[1][5])
+    T.check(nodes >= 10 and corr < -0.95 and 0.5 < abs(ratio) < 3,
+            f"stick-shear.py: the shear's alternation over {nodes} sticking nodes follows the pressure "
+            f"jump across them (correlation {corr:+.3f}, below -0.95; shear / jump {ratio})")
 else:
     T.check(False, f"stick-shear.py: exit {p.returncode}, {p.stdout[-300:]} {p.stderr[-300:]}")
 
