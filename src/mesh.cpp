@@ -91,16 +91,19 @@ AnnulusGenerator::AnnulusGenerator(std::array<double, 3> center, double innerRad
   radius_.assign(nr + 1, innerRadius);
   for (int k = 0; k < nr; ++k) radius_[k + 1] = radius_[k] + (outerRadius - innerRadius) * std::pow(q, k) / sum;
   radius_[nr] = outerRadius;
-  // Angles: uniform, or m cells over the sector's width and the rest over the remainder.
-  const int nt = cells[1];
+  angle_ = ringAngles(cells[1], sector);
+}
+
+std::vector<double> AnnulusGenerator::ringAngles(int nt, std::array<double, 3> sector) {
   const double width = sector[1] * M_PI / 180;
   const int m = width > 0 ? std::clamp(int(std::lround(sector[2] * nt)), 1, nt - 1) : 0;
-  angle_.resize(nt);
+  std::vector<double> angle(nt);
   const double start = m ? sector[0] * M_PI / 180 - width / 2 : 0.0;
   for (int j = 0; j < nt; ++j)
-    angle_[j] = m == 0 ? 2 * M_PI * j / nt
-                : j <= m ? start + width * j / m
-                         : start + width + (2 * M_PI - width) * (j - m) / (nt - m);
+    angle[j] = m == 0 ? 2 * M_PI * j / nt
+               : j <= m ? start + width * j / m
+                        : start + width + (2 * M_PI - width) * (j - m) / (nt - m);
+  return angle;
 }
 
 GO AnnulusGenerator::numElements() const { return n_[0] * n_[1] * n_[2]; }

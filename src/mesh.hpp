@@ -103,6 +103,10 @@ class AnnulusGenerator : public MeshGenerator {
   std::vector<BoundaryFace> boundaryFaces(GO element) const override;
   std::vector<GO> faceNeighbours(GO element) const override;
   GO ringNeighbour(GO node, int step) const override;
+  // The nt ring angles (radians, increasing from the first): uniform, or
+  // round(fraction x nt) cells over the sector {centre, width (degrees), fraction}
+  // and the rest over the remainder.
+  static std::vector<double> ringAngles(int nt, std::array<double, 3> sector);
 
  private:
   std::array<double, 3> center_;

@@ -21,6 +21,7 @@
 #include <sstream>
 
 #include "errors.hpp"
+#include "mesh.hpp"
 #include "parameters.hpp"
 #include "vec3.hpp"
 
@@ -667,6 +668,16 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
       v.fail("Mesh/Fine Sector", "the centre must be finite and the width in [0, 360) degrees");
     if (fs[1] > 0 && !(fs[2] > 0 && fs[2] < 1))
       v.fail("Mesh/Fine Sector", "the fraction of cells in the sector must be in (0, 1)");
+    // A straight-sided cell spanning half the ring or more turns inside out.
+    if (m.cells[1] >= 3) {
+      const auto angle = AnnulusGenerator::ringAngles(m.cells[1], fs);
+      double widest = 2 * M_PI + angle.front() - angle.back();
+      for (size_t j = 1; j < angle.size(); ++j) widest = std::max(widest, angle[j] - angle[j - 1]);
+      if (!(widest < M_PI))
+        v.fail("Mesh/Cells", "a ring cell spans " + std::to_string(std::lround(widest * 180 / M_PI)) +
+                                 " degrees (Fine Sector leaves " + std::to_string(m.cells[1]) +
+                                 " circumferential cells too few outside it); every cell must span less than 180");
+    }
     m.min = {m.center[0] - m.outerRadius, m.center[1] - m.outerRadius, m.center[2]};
     m.max = {m.center[0] + m.outerRadius, m.center[1] + m.outerRadius, m.center[2] + m.length};
     nodes = double(m.cells[0] + 1.0) * m.cells[1] * (m.cells[2] + 1.0);

@@ -282,6 +282,8 @@ roller_case("core: unknown rotation", ["Supports/core/Rotation=Spinning"], "Supp
 roller_case("core: zero axis", ["Supports/core/Axis Direction={0, 0, 0}"], "Supports/core/Axis Direction")
 roller_case("core: negative contact smoothing", ["Capstans/capstan/Contact/Smoothing=-1"], "Capstans/capstan/Contact/Smoothing")
 roller_case("rigid-core parameter on a Roller", ["Supports/front/Torque=1"], "Supports/front/Torque")
+roller_case("a ring cell of half the ring or more (3 cells, a fine sector)", ["Mesh/Cells={1, 3, 1}"],
+            "Mesh/Cells")
 
 # --- an output directory in use by another run ------------------------------------------
 # A 10-step steady brake sweep (a few seconds) holds the directory; a second run into it
