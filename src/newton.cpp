@@ -583,7 +583,7 @@ NewtonResult NewtonSolver::solve(Vector& u, double tolerance) {
     r.iterations = solver->getNumIterations();
     r.residualNorm = g.getNormF();
   } catch (const std::exception& e) {
-    r.failure = std::string("nonlinear solver error: ") + e.what();
+    r.failure = "nonlinear solver error: " + trilinosMessage(e.what());  // less Teuchos' throw details
   }
   auto& out = params->sublist("Direction").sublist("Newton").sublist("Linear Solver").sublist("Output");
   r.linearIterations = out.get("Cumulative Iteration Count", 0);
