@@ -754,6 +754,22 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
       v.fail("Solver/Linear Solver", "CG needs a symmetric matrix; friction on capstan '" + c.name +
                                          "' makes it non-symmetric (use Auto, GMRES or Direct)");
 
+  // Steady rolling makes a free core's rotation unknown its angular velocity,
+  // which moves no node: the torque balance's row has no diagonal entry, and
+  // MueLu's smoothed aggregation and Jacobi divide by the diagonal (MueLu: "Prolongator
+  // damping factor needs to be finite").
+  using Prec = SolverSettings::Preconditioner;
+  const bool turningSteady = sc.analysis.steady() &&
+                             std::any_of(sc.supports.begin(), sc.supports.end(), [](const SupportSpec& s) {
+                               return s.isCore() && s.rotation == SupportSpec::Rotation::Free;
+                             });
+  if (turningSteady && sc.solver.linearSolver != SolverSettings::LinearSolver::Direct &&
+      (sc.solver.preconditioner == Prec::MueLu || sc.solver.preconditioner == Prec::Jacobi))
+    v.fail("Solver/Preconditioner", std::string(sc.solver.preconditioner == Prec::MueLu ? "MueLu" : "Jacobi") +
+                                        " cannot precondition steady rolling with a free-turning core: its angular "
+                                        "velocity's row (the torque balance) has no diagonal entry (use Auto or LU, "
+                                        "ILU, or Linear Solver = Direct)");
+
   const auto& out = P.sublist("Output");
   sc.outputDirectory = out.get<std::string>("Directory");
   if (sc.outputDirectory.empty()) v.fail("Output/Directory", "must not be empty");

@@ -21,7 +21,8 @@ void SolverSettings::declare(ParameterList& sol) {
   sol.set("Preconditioner", std::string("Auto"),
           "Auto | ILU | Jacobi | MueLu | LU | None (Ifpack2 RILUK per rank, Jacobi relaxation; MueLu smoothed "
           "aggregation with the rigid-body modes; LU: a MUMPS factorisation kept across Newton iterations "
-          "while it works, see Preconditioner Reuse). Auto: MueLu from 1000 dofs, ILU below");
+          "while it works, see Preconditioner Reuse). Auto: LU in steady rolling, else MueLu from 1000 dofs, ILU "
+          "below");
   sol.set("ILU Level", 1, "ILU: level of fill (>= 0)");
   sol.set("Preconditioner Reuse", std::string("Adaptive"),
           "Adaptive | None. Adaptive: Newton builds its preconditioner at each load step's start "
@@ -220,8 +221,8 @@ SolverSettings SolverSettings::resolved(long dofs, bool annulus, bool friction, 
       if (s.preconditioner == Preconditioner::Auto) s.preconditioner = Preconditioner::LU;
     }
   }
-  if (s.preconditioner == Preconditioner::Auto)
-    s.preconditioner = dofs >= 1000 ? Preconditioner::MueLu : Preconditioner::ILU;
+  if (s.preconditioner == Preconditioner::Auto)  // steady rolling: never MueLu (above)
+    s.preconditioner = steady ? Preconditioner::LU : dofs >= 1000 ? Preconditioner::MueLu : Preconditioner::ILU;
   return s;
 }
 

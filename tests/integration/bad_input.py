@@ -284,6 +284,10 @@ roller_case("core: negative contact smoothing", ["Capstans/capstan/Contact/Smoot
 roller_case("rigid-core parameter on a Roller", ["Supports/front/Torque=1"], "Supports/front/Torque")
 roller_case("a ring cell of half the ring or more (3 cells, a fine sector)", ["Mesh/Cells={1, 3, 1}"],
             "Mesh/Cells")
+STEADY = T.input("pinch-roller-slice-steady.xml")
+for pc in ("MueLu", "Jacobi"):
+    case(f"steady rolling, a free-turning core, GMRES + {pc}", STEADY, [STEADY, "Solver/Preconditioner", pc],
+         args=["--set", "Solver/Linear Solver=GMRES", "--set", f"Solver/Preconditioner={pc}"])
 
 # --- an output directory in use by another run ------------------------------------------
 # A 10-step steady brake sweep (a few seconds) holds the directory; a second run into it
