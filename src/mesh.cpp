@@ -96,7 +96,7 @@ AnnulusGenerator::AnnulusGenerator(std::array<double, 3> center, double innerRad
 
 std::vector<double> AnnulusGenerator::ringAngles(int nt, std::array<double, 3> sector) {
   const double width = sector[1] * M_PI / 180;
-  const int m = width > 0 ? std::clamp(int(std::lround(sector[2] * nt)), 1, nt - 1) : 0;
+  const int m = sectorCells(nt, sector);
   std::vector<double> angle(nt);
   const double start = m ? sector[0] * M_PI / 180 - width / 2 : 0.0;
   for (int j = 0; j < nt; ++j)

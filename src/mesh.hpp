@@ -6,7 +6,9 @@
 // graph with METIS (the graph only: about 7 integers per element).
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <map>
 #include <string>
 #include <vector>
@@ -104,9 +106,17 @@ class AnnulusGenerator : public MeshGenerator {
   std::vector<GO> faceNeighbours(GO element) const override;
   GO ringNeighbour(GO node, int step) const override;
   // The nt ring angles (radians, increasing from the first): uniform, or
-  // round(fraction x nt) cells over the sector {centre, width (degrees), fraction}
+  // sectorCells() cells over the sector {centre, width (degrees), fraction}
   // and the rest over the remainder.
   static std::vector<double> ringAngles(int nt, std::array<double, 3> sector);
+  static int sectorCells(int nt, const std::array<double, 3>& sector) {
+    return sector[1] > 0 ? std::clamp(int(std::lround(sector[2] * nt)), 1, nt - 1) : 0;
+  }
+  // The widest ring cell, in degrees (the scene's check; no allocation).
+  static double widestRingCellDegrees(int nt, const std::array<double, 3>& sector) {
+    const int m = sectorCells(nt, sector);
+    return m == 0 ? 360.0 / nt : std::max(sector[1] / m, (360 - sector[1]) / (nt - m));
+  }
 
  private:
   std::array<double, 3> center_;

@@ -670,11 +670,9 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
       v.fail("Mesh/Fine Sector", "the fraction of cells in the sector must be in (0, 1)");
     // A straight-sided cell spanning half the ring or more turns inside out.
     if (m.cells[1] >= 3) {
-      const auto angle = AnnulusGenerator::ringAngles(m.cells[1], fs);
-      double widest = 2 * M_PI + angle.front() - angle.back();
-      for (size_t j = 1; j < angle.size(); ++j) widest = std::max(widest, angle[j] - angle[j - 1]);
-      if (!(widest < M_PI))
-        v.fail("Mesh/Cells", "a ring cell spans " + std::to_string(std::lround(widest * 180 / M_PI)) +
+      const double widest = AnnulusGenerator::widestRingCellDegrees(m.cells[1], fs);
+      if (!(widest < 180))
+        v.fail("Mesh/Cells", "a ring cell spans " + std::to_string(std::lround(widest)) +
                                  " degrees (Fine Sector leaves " + std::to_string(m.cells[1]) +
                                  " circumferential cells too few outside it); every cell must span less than 180");
     }
