@@ -207,13 +207,13 @@ bool readDouble(const std::string& text, double& x) {
   return end == t.c_str() + t.size() && errno != ERANGE && std::isfinite(x);
 }
 
-// As the scene files spell a bool (Teuchos' XML: true/false, also 1/0),
-// whatever the case; anything else is bad input, not false.
+// As the scene files spell a bool (Teuchos' XML reader: true/false, yes/no),
+// whatever the case, and 1/0; anything else is bad input, not false.
 bool readBool(const std::string& text) {
   std::string t = text;
   for (auto& c : t) c = char(std::tolower(static_cast<unsigned char>(c)));
-  if (t == "true" || t == "1") return true;
-  if (t == "false" || t == "0") return false;
+  if (t == "true" || t == "yes" || t == "1") return true;
+  if (t == "false" || t == "no" || t == "0") return false;
   throw std::invalid_argument("not a bool");
 }
 
