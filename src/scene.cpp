@@ -672,9 +672,10 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
     if (m.cells[1] >= 3) {
       const double widest = AnnulusGenerator::widestRingCellDegrees(m.cells[1], fs);
       if (!(widest < 180))
-        v.fail("Mesh/Cells", "a ring cell spans " + std::to_string(std::lround(widest)) +
-                                 " degrees (Fine Sector leaves " + std::to_string(m.cells[1]) +
-                                 " circumferential cells too few outside it); every cell must span less than 180");
+        v.fail("Mesh/Cells", "a ring cell spans " + std::to_string(std::lround(widest)) + " degrees: " +
+                                 std::to_string(m.cells[1]) +
+                                 " circumferential cells are too few for Mesh/Fine Sector (every cell must span "
+                                 "less than 180)");
     }
     m.min = {m.center[0] - m.outerRadius, m.center[1] - m.outerRadius, m.center[2]};
     m.max = {m.center[0] + m.outerRadius, m.center[1] + m.outerRadius, m.center[2] + m.length};
