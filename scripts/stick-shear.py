@@ -22,9 +22,11 @@ node: the table gives the correlation of the two's alternating parts (each less 
 axis, radius and turning sense come from the run's scene (summary.json's "scene", read
 relative to the current directory, or --scene).
 """
-import xml.etree.ElementTree as ET
 import argparse
+import csv
+import json
 import os
+import xml.etree.ElementTree as ET
 
 import h5py
 import numpy as np
@@ -92,9 +94,8 @@ def capstan_of(scene_path):
 
 
 def node_jumps(run):
-    """Per sticking node with two sticking ring neighbours: (shear, pressure jump)."""
-    import csv
-    import json
+    """Per sticking node with two sticking ring neighbours: the alternating parts of
+    (shear, pressure jump)."""
     with open(os.path.join(run, "summary.json")) as f:
         scene = args.scene or json.load(f)["scene"]
     a, b, radius, sense, roller = capstan_of(scene)
@@ -118,7 +119,7 @@ def node_jumps(run):
     rn = np.hypot(X[:, 0], X[:, 1])
     surface = np.unique(hexes[outer])
     surface = surface[np.abs(rn[surface] - rn[surface].max()) < 1e-9]
-    n0 = roller - a
+    n0 = roller - a  # the mesh's centre, not the core's moved axis (nip.csv's): 1e-3 mm of s apart
     n0 = n0 - b * (n0 @ b)
     n0 /= np.linalg.norm(n0)
     d = x[surface] - a
@@ -139,7 +140,8 @@ def node_jumps(run):
             k = int(np.argmin((s_n - s_) ** 2 + (z_n - z) ** 2))
             n = int(surface[k])
             els = owner.get(n, [])
-            # the two outer elements beside the node at this z (nearest in z)
+            # the outer elements holding the node, nearest in z first: two behind it and two
+            # ahead where it sits between axial layers, one each on a face of the body
             els = sorted(els, key=lambda el: abs(((centre[el] - a) @ b) - z))[:4]
             ang = {el: np.arctan2(np.cross(n0, centre[el] - a) @ b, (centre[el] - a) @ n0) for el in els}
             behind = [el for el in els if sense * ang[el] < sense * phi[k]]
