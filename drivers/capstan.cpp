@@ -133,7 +133,7 @@ int main(int argc, char** argv) {
     if (rank0)
       for (const auto& w : scene.warnings) std::cerr << "capstan: WARNING: " << w << "\n";
     if (args.command == "validate") {
-      if (rank0) Teuchos::writeParameterListToXmlOStream(scene.resolved, std::cout);
+      if (rank0) Teuchos::writeParameterListToXmlOStream(capstan::printableScene(scene), std::cout);
       return 0;
     }
     return capstan::runScene(scene, comm, {args.quiet, args.restart, args.log, args.checkTangent});

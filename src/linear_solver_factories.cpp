@@ -8,6 +8,7 @@
 #include <string>
 
 #include "assembly.hpp"
+#include "errors.hpp"
 #include "mumps_solve_factory.hpp"
 #include "program_directory.hpp"
 
@@ -120,11 +121,41 @@ RCP<Tpetra::MultiVector<>> rigidBodyModes(const Assembly& assembly) {
 
 }  // namespace
 
+namespace {
+
+// Solver/Belos checked against the Belos solver's own list (Belos' solvers
+// read theirs without checking names, so a misspelt one would be lost); an
+// int where Belos takes a double is read as one.
+ParameterList checkedBelosList(const ParameterList& scene, const std::string& type) {
+  const auto valid = Thyra::BelosLinearOpWithSolveFactory<double>().getValidParameters()->sublist("Solver Types").sublist(type);
+  ParameterList checked = scene;
+  for (const auto& entry : scene) {
+    const std::string& name = entry.first;
+    if (!valid.isParameter(name))
+      throw InputError("parameter 'Solver/Belos/" + name + "': unknown to Belos' " + type + " solver");
+    if (valid.isSublist(name) || scene.isSublist(name)) continue;  // e.g. Belos' own output lists
+    const auto& want = valid.getEntry(name).getAny(false).type();
+    const auto& got = scene.getEntry(name).getAny(false);
+    if (got.type() == want) continue;
+    if (want == typeid(double) && got.type() == typeid(int)) {
+      checked.set(name, double(Teuchos::any_cast<int>(got)));
+      continue;
+    }
+    throw InputError("parameter 'Solver/Belos/" + name + "': Belos' " + type + " solver takes type " +
+                     valid.getEntry(name).getAny(false).typeName() + ", got " + got.typeName());
+  }
+  return checked;
+}
+
+}  // namespace
+
 Teuchos::ParameterList stratimikosList(const SolverSettings& solver, const Assembly& assembly) {
   const int ranks = assembly.dofMap()->getComm()->getSize();
   Teuchos::ParameterList p("Stratimikos");
   using S = SolverSettings;
   const S::LinearSolver method = solver.linearSolver;
+  const std::string belosType = method == S::LinearSolver::CG ? "Pseudo Block CG" : "Block GMRES";
+  const ParameterList belosScene = checkedBelosList(solver.belos, belosType);
   // Direct: MUMPS on any number of ranks (src/mumps_solve_factory.hpp).
   // Amesos2's KLU2, still selectable through Solver/Stratimikos, solves our
   // matrices wrongly on several ranks in Trilinos 13.2.
@@ -134,7 +165,7 @@ Teuchos::ParameterList stratimikosList(const SolverSettings& solver, const Assem
   } else {
     p.set("Linear Solver Type", "Belos");
     auto& belos = p.sublist("Linear Solver Types").sublist("Belos");
-    const std::string type = method == S::LinearSolver::CG ? "Pseudo Block CG" : "Block GMRES";
+    const std::string& type = belosType;
     belos.set("Solver Type", type);
     auto& st = belos.sublist("Solver Types").sublist(type);
     st.set("Convergence Tolerance", solver.linearTolerance);
@@ -143,6 +174,7 @@ Teuchos::ParameterList stratimikosList(const SolverSettings& solver, const Assem
       st.set("Num Blocks", 200);
       st.set("Maximum Restarts", 20);
     }
+    st.setParameters(belosScene);
     const S::Preconditioner prec = solver.preconditioner;
     if (prec == S::Preconditioner::None) {
       p.set("Preconditioner Type", "None");
@@ -218,6 +250,7 @@ Teuchos::ParameterList stratimikosList(const SolverSettings& solver, const Assem
         ifp.set("Prec Type", "RELAXATION");
         ifp.sublist("Ifpack2 Settings").set("relaxation: type", "Jacobi");
       }
+      ifp.sublist("Ifpack2 Settings").setParameters(solver.ifpack2);
     }
   }
   p.setParameters(solver.stratimikos);

@@ -299,16 +299,23 @@ NewtonSolver::NewtonSolver(Assembly& assembly, const SolverSettings& settings)
   } catch (const PluginError&) {
     throw;
   } catch (const std::exception& e) {
-    throw InputError("parameter 'Solver/Stratimikos': " + trilinosMessage(e.what()));
+    // Stratimikos checks the Ifpack2 settings here, where Solver/Ifpack2 went.
+    std::string what = e.what();
+    what = what.substr(0, what.find("The valid parameters and types are"));  // a page of them
+    const bool ifpack2 = solver.ifpack2.numParams() > 0 && what.find("Ifpack2 Settings") != std::string::npos;
+    throw InputError(std::string("parameter '") + (ifpack2 ? "Solver/Ifpack2" : "Solver/Stratimikos") +
+                     "': " + trilinosMessage(what));
   }
   impl_->model = rcp(new BodyModel(assembly, impl_->lows));
   impl_->W = impl_->model->create_W_op();
   // MueLu and Ifpack2 read their parameters only when a preconditioner is
   // built. A scene that passes its own (Solver/Stratimikos/Preconditioner
-  // Types) gets one built now, on the tangent at the undeformed state, so that
-  // a bad name or value stops the run before anything is written.
+  // Types, or Solver/Ifpack2 to an Ifpack2 preconditioner) gets one built now,
+  // on the tangent at the undeformed state, so that a bad name or value stops
+  // the run before anything is written.
   const auto& strat = solver.stratimikos;
-  if (!impl_->newtonPrecFactory.is_null() && strat.isSublist("Preconditioner Types")) {
+  const bool ownIfpack2 = solver.ifpack2.numParams() > 0 && impl_->strat.get<std::string>("Preconditioner Type", "") == "Ifpack2";
+  if (!impl_->newtonPrecFactory.is_null() && (strat.isSublist("Preconditioner Types") || ownIfpack2)) {
     try {
       Vector zero(assembly.dofMap());
       auto K = assembly.createMatrix();
@@ -322,7 +329,9 @@ NewtonSolver::NewtonSolver(Assembly& assembly, const SolverSettings& settings)
     } catch (const std::exception& e) {
       std::string what = e.what();
       what = what.substr(0, what.find("The valid parameters and types are"));  // a page of them
-      throw InputError("parameter 'Solver/Stratimikos/Preconditioner Types': " + trilinosMessage(what));
+      throw InputError(std::string("parameter '") +
+                       (strat.isSublist("Preconditioner Types") ? "Solver/Stratimikos/Preconditioner Types" : "Solver/Ifpack2") +
+                       "': " + trilinosMessage(what));
     }
   }
   try {

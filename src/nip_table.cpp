@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "collective.hpp"
+#include "csv.hpp"
 #include "model.hpp"
 #include "outputs.hpp"
 #include "vec3.hpp"
@@ -28,10 +29,40 @@ void NipTable::open(int lastKept) {
   writeAtomically(file_, text_);
 }
 
+namespace {
+
+// The line of centres' direction, from the capstan's axis across it towards
+// the body: towards the roller's axis (an annulus), or on a box along the
+// inward normals of the faces the capstan touches (G1's capstan pressing on
+// ymax: -y, so s = 0 under the axis wherever the capstan has moved).
+std::array<double, 3> lineOfCentres(const MeshSpec& mesh, const CapstanSpec& capstan, const std::array<double, 3>& roller,
+                                    const std::array<double, 3>& a, const std::array<double, 3>& b) {
+  std::array<double, 3> n0{0, 0, 0};
+  if (mesh.type == MeshSpec::Type::Box) {
+    for (const auto& face : capstan.contactFaces) {
+      const char* names[6] = {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
+      for (int k = 0; k < 6; ++k)
+        if (face == names[k]) n0[k / 2] += k % 2 == 0 ? 1.0 : -1.0;
+    }
+  }
+  n0 = sub(n0, scale(b, dot(n0, b)));
+  if (!(norm(n0) > 1e-12)) {  // an annulus, or box faces whose normals cancel: towards the roller's axis
+    n0 = sub(roller, a);
+    n0 = sub(n0, scale(b, dot(n0, b)));
+  }
+  return scale(n0, 1 / norm(n0));
+}
+
+}  // namespace
+
 std::string NipTable::rows(int step) const {
   const auto& assembly = *m_.assembly;
-  // The roller's axis: the inner face's rigid core where it has one, else the annulus axis.
-  std::array<double, 3> roller = m_.scene.mesh.center;
+  // The roller's axis: the inner face's rigid core where it has one, else the
+  // annulus axis (a box: its centre).
+  const auto& mesh = m_.scene.mesh;
+  std::array<double, 3> roller = mesh.center;
+  if (mesh.type == MeshSpec::Type::Box)
+    for (int i = 0; i < 3; ++i) roller[i] = 0.5 * (mesh.min[i] + mesh.max[i]);
   for (const auto& core : assembly.rigidCores())
     for (int i = 0; i < 3; ++i) roller[i] = core.axisPoint[i] + core.translation[i];
   std::ostringstream out;
@@ -46,10 +77,7 @@ std::string NipTable::rows(int step) const {
     const auto cyl = contact.cylinder();
     const std::array<double, 3> b{cyl.b[0], cyl.b[1], cyl.b[2]}, a{cyl.a[0], cyl.a[1], cyl.a[2]};
     const double sense = contact.capstan().angularVelocity >= 0 ? 1.0 : -1.0;
-    // n0: from the capstan's axis towards the roller's, across the axis.
-    std::array<double, 3> n0 = sub(roller, a);
-    n0 = sub(n0, scale(b, dot(n0, b)));
-    n0 = scale(n0, 1 / norm(n0));
+    const std::array<double, 3> n0 = lineOfCentres(m_.scene.mesh, contact.capstan(), roller, a, b);
     const int nq = kernels::facePointCount(contact.rule());
     const double smoothing = contact.settings().smoothing;
     for (size_t f = 0; f < cp.extent(0); ++f)
@@ -74,7 +102,7 @@ std::string NipTable::rows(int step) const {
           slipRate = mag > 0 ? -slip * shear / mag : 0.0;
           state = int(fp(f, q, FrictionEffect::kState)) == 1 ? "stick" : "slip";
         }
-        out << step << ',' << contact.capstan().name << ',' << sense * contact.radius() * phi << ','
+        out << step << ',' << csvCell(contact.capstan().name) << ',' << sense * contact.radius() * phi << ','
             << dot(sub(x, a), b) << ',' << pressure << ',' << shear << ',' << slipRate << ',' << state << '\n';
       }
   }

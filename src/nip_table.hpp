@@ -1,7 +1,8 @@
 // nip.csv (interface.md, "Steady rolling"): one row per contact point in
 // contact and converged step, `step,capstan,s,z,pressure,shear,slip_rate,state`.
 // s: arc length on the capstan's surface from the line of centres (the
-// capstan's axis to the roller's), positive along the capstan's surface
+// capstan's axis to the roller's; on a box, the perpendicular from the axis
+// to the faces it touches), positive along the capstan's surface
 // motion; z: along the capstan's axis; shear and slip_rate: the friction
 // traction on the body and the body's slip rate on the capstan along that
 // motion. Written in both analyses (quasi-static: the step's last increment).

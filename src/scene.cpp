@@ -36,7 +36,7 @@ namespace {
 // against this template.
 const char* kAnyName = "<any name>";
 // Sublists passed through to Trilinos unchanged.
-const std::set<std::string> kPassThrough = {"NOX", "Stratimikos"};
+const std::set<std::string> kPassThrough = {"NOX", "Stratimikos", "Belos", "Ifpack2"};
 
 Array<double> vec3(double a, double b, double c) { return Teuchos::tuple(a, b, c); }
 
@@ -311,6 +311,8 @@ void checkXml(const Teuchos::XMLObject& list, const std::string& path, const Val
   for (int i = 0; i < list.numChildren(); ++i) {
     const auto& child = list.getChild(i);
     const std::string& tag = child.getTag();
+    // Teuchos' writer ends every list it writes (capstan validate's) with one.
+    if (tag == "Validators" && child.numChildren() == 0 && path.empty()) continue;
     if (tag != "ParameterList" && tag != "Parameter")
       v.fail(path, "unknown XML element <" + tag + "> (a scene has ParameterList and Parameter elements)");
     if (!child.hasAttribute("name"))
@@ -469,6 +471,18 @@ void applySet(ParameterList& scene, const ParameterList& valid, const std::strin
   const Teuchos::ParameterEntry* typed = list->isParameter(name) ? &list->getEntry(name)
                                          : (vlist && vlist->isParameter(name)) ? &vlist->getEntry(name)
                                                                                : nullptr;
+  bool passedThrough = false;  // inside a Trilinos sublist: typed by how VALUE reads
+  for (size_t i = 0; i + 1 < parts.size(); ++i) passedThrough = passedThrough || kPassThrough.count(parts[i]) > 0;
+  if (!typed && passedThrough) {
+    int i;
+    double d;
+    const std::string lower = trimmed(value);
+    if (readInt(value, i)) list->set(name, i);
+    else if (readDouble(value, d)) list->set(name, d);
+    else if (lower == "true" || lower == "false") list->set(name, lower == "true");
+    else list->set(name, value);
+    return;
+  }
   if (!typed) throw InputError(file + ": --set: parameter '" + path + "': unknown parameter");
   const auto& t = typed->getAny(false).type();
   try {
@@ -547,18 +561,38 @@ void applyAccuracyPreset(ParameterList& user, const Validator& v) {
 // A mesh parameter of the other mesh type would be silently ignored: most likely
 // a forgotten or misspelled Mesh/Type, so it is an error. Checked on the user's
 // list, before defaults fill in every parameter of both types.
+static const std::vector<std::string>& otherMeshTypeParameters(const std::string& type) {
+  static const std::vector<std::string> boxOnly = {"Min", "Max"}, none;
+  static const std::vector<std::string> annulusOnly = {"Center", "Inner Radius", "Outer Radius", "Length",
+                                                       "Outer Cell Ratio", "Fine Sector"};
+  return type == "Annulus" ? boxOnly : type == "Box" ? annulusOnly : none;
+}
+
 static void rejectOtherMeshTypeParameters(const ParameterList& user, const Validator& v) {
   if (!user.isSublist("Mesh")) return;
   const auto& mesh = user.sublist("Mesh");
   const std::string type = mesh.isType<std::string>("Type") ? mesh.get<std::string>("Type") : "Box";
-  const std::vector<std::string> boxOnly = {"Min", "Max"};
-  const std::vector<std::string> annulusOnly = {"Center", "Inner Radius", "Outer Radius", "Length",
-                                                "Outer Cell Ratio", "Fine Sector"};
-  const auto& other = type == "Annulus" ? boxOnly : type == "Box" ? annulusOnly : std::vector<std::string>{};
-  for (const auto& name : other)
+  for (const auto& name : otherMeshTypeParameters(type))
     if (mesh.isParameter(name))
       v.fail("Mesh/" + name, "is not a parameter of Mesh/Type = " + type + " (it belongs to " +
                                  (type == "Box" ? "Annulus" : "Box") + ")");
+}
+
+// Two supports that prescribe the same component of one face contradict each
+// other (one would silently win): Fixed, Roller, Displacement and Rigid Core
+// prescribe their components; a Foundation only adds a spring.
+static void rejectSupportsHoldingOneComponentTwice(const std::vector<SupportSpec>& supports, const Validator& v) {
+  using T = SupportSpec::Type;
+  for (size_t j = 0; j < supports.size(); ++j)
+    for (size_t i = 0; i < j; ++i) {
+      const auto &a = supports[i], &b = supports[j];
+      if (a.face != b.face || a.type == T::Foundation || b.type == T::Foundation) continue;
+      for (int c = 0; c < 3; ++c)
+        if (a.components[c] && b.components[c])
+          v.fail("Supports/" + b.name + "/Face",
+                 "face '" + b.face + "' is already held along " + char('x' + c) + " by Supports/" + a.name + " (" +
+                     nameOf(a.type, SupportSpec::types) + "): two supports cannot prescribe one component");
+    }
 }
 
 // A free rigid-core component that nothing can ever hold makes every tangent
@@ -612,6 +646,41 @@ Scene loadScene(const std::string& file, const std::vector<std::string>& sets,
   return parseScene(content, file, sets, outputOverride);
 }
 
+namespace {
+// The values alone: Teuchos writes a list's validators (the defaults carry
+// them) as a <Validators> block, which no scene may hold.
+ParameterList valuesOnly(const ParameterList& list) {
+  ParameterList out(list.name());
+  for (auto it = list.begin(); it != list.end(); ++it) {
+    const auto& name = list.name(it);
+    const auto& entry = list.entry(it);
+    if (entry.isList()) out.set(name, valuesOnly(list.sublist(name)));
+    else out.setEntry(name, Teuchos::ParameterEntry(entry.getAny(), entry.isDefault(), false, entry.docString()));
+  }
+  return out;
+}
+}  // namespace
+
+ParameterList printableScene(const Scene& scene) {
+  ParameterList p = valuesOnly(scene.resolved);
+  p.setName("Scene");
+  p.set("Accuracy", std::string("Scene"));  // the preset's cells and tolerances are in the values already
+  auto& mesh = p.sublist("Mesh");
+  for (const auto& name : otherMeshTypeParameters(mesh.get<std::string>("Type"))) mesh.remove(name);
+  if (p.isSublist("Supports")) {
+    auto& supports = p.sublist("Supports");
+    for (auto it = supports.begin(); it != supports.end(); ++it) {
+      auto& s = supports.sublist(supports.name(it));
+      const std::string type = s.get<std::string>("Type");
+      std::vector<std::string> unread;
+      for (auto jt = s.begin(); jt != s.end(); ++jt)
+        if (!SupportSpec::readBy(s.name(jt), type)) unread.push_back(s.name(jt));
+      for (const auto& name : unread) s.remove(name);
+    }
+  }
+  return p;
+}
+
 Scene parseScene(const std::string& content, const std::string& file, const std::vector<std::string>& sets,
                  const std::string& outputOverride) {
   Validator v{file};
@@ -626,7 +695,7 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
   if (!outputOverride.empty()) user->sublist("Output").set("Directory", outputOverride);
   applyAccuracyPreset(*user, v);
   rejectOtherMeshTypeParameters(*user, v);
-  if (user->isSublist("Supports")) SupportSpec::rejectCoreParametersElsewhere(user->sublist("Supports"), v);
+  if (user->isSublist("Supports")) SupportSpec::rejectParametersOfOtherTypes(user->sublist("Supports"), v);
   v.check(*user, valid, "");
 
   Scene sc;
@@ -702,6 +771,7 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
   const auto& sups = P.sublist("Supports");
   for (auto it = sups.begin(); it != sups.end(); ++it)
     sc.supports.push_back(SupportSpec::parse(sups.sublist(sups.name(it)), sups.name(it), faceNames, v));
+  rejectSupportsHoldingOneComponentTwice(sc.supports, v);
 
   const auto& caps = P.sublist("Capstans");
   for (auto it = caps.begin(); it != caps.end(); ++it) {
@@ -726,6 +796,10 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
       if (!faceNames.count(f)) v.fail(path + "/Contact Faces", "'" + f + "' is not a face of the mesh (" + faceText + ")");
     cs.contact = ContactSettings::parse(c.sublist("Contact"), path + "/Contact", v);
     cs.friction = FrictionSettings::parse(c.sublist("Friction"), path + "/Friction", v);
+    if (cs.friction.on() && !cs.friction.grips())  // runs (its kernel reports stick and slip), carries nothing
+      sc.warnings.push_back(sc.file + ": parameter '" + path + "/Friction/Coefficient': 0 with Law = " +
+                            nameOf(cs.friction.law, FrictionSettings::laws) +
+                            ": the friction kernel runs but carries no traction (Law = None runs none)");
     sc.capstans.push_back(cs);
   }
 
@@ -733,8 +807,10 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
   sc.steps = time.get<int>("Steps");
   if (sc.steps < 1) v.fail("Time/Steps", "must be >= 1, got " + std::to_string(sc.steps));
   sc.stepSize = v.positive(time, "Time", "Step Size");
-  rejectSingularCores(sc, v);
+  // The analysis' own demands first: a steady scene's capstan across the
+  // annulus axis is that axis' fault, not the core's it cannot push.
   AnalysisSettings::checkScene(sc, v);
+  rejectSingularCores(sc, v);
   for (auto& s : sc.supports)
     if (s.isCore() && s.rampTime == 0) s.rampTime = sc.stepSize;
   for (auto& s : sc.supports)

@@ -77,4 +77,9 @@ Scene loadScene(const std::string& file, const std::vector<std::string>& sets,
 Scene parseScene(const std::string& content, const std::string& file, const std::vector<std::string>& sets,
                  const std::string& outputOverride);
 
+// The resolved scene as `capstan validate` prints it: every parameter the
+// scene's types read, with its value or default, as a scene file that
+// capstan reads back to the same scene.
+Teuchos::ParameterList printableScene(const Scene& scene);
+
 }  // namespace capstan

@@ -87,6 +87,12 @@ void SolverSettings::declare(ParameterList& sol) {
           "(and where the pressure loop is monolithic)");
   sol.sublist("NOX", false, "Passed to NOX unchanged, over capstan's defaults");
   sol.sublist("Stratimikos", false, "Passed to Stratimikos unchanged, over capstan's defaults");
+  sol.sublist("Belos", false,
+              "Passed to the Belos solver (Block GMRES, or Pseudo Block CG with Linear Solver = CG) unchanged, "
+              "over capstan's defaults; its names are checked against the solver's (unused with Direct)");
+  sol.sublist("Ifpack2", false,
+              "Passed to the Ifpack2 preconditioner (Preconditioner = ILU or Jacobi) unchanged, over capstan's "
+              "defaults (unused with the other preconditioners)");
 }
 
 SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterReader& r, bool friction,
@@ -176,6 +182,8 @@ SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterRe
     s.minimumSolvePenalty = s.pressureUpdate == PressureUpdate::SaddlePoint && !friction ? 3e-2 : 1e-2;
   s.nox = sol.sublist("NOX");
   s.stratimikos = sol.sublist("Stratimikos");
+  s.belos = sol.sublist("Belos");
+  s.ifpack2 = sol.sublist("Ifpack2");
   return s;
 }
 

@@ -67,6 +67,9 @@ struct SolverSettings {
   // factors its symmetric part (MumpsOptions::symmetricPart).
   bool unsymmetric = false;
   Teuchos::ParameterList nox, stratimikos;  // passed to NOX and Stratimikos over capstan's defaults
+  // Passed to the Belos solver (GMRES or CG) and to the Ifpack2 preconditioner
+  // (ILU, Jacobi) over capstan's defaults; Solver/Stratimikos over both.
+  Teuchos::ParameterList belos, ifpack2;
 
   static void declare(Teuchos::ParameterList& solver);
   // `friction`: some capstan has friction; `rolling`: a free-turning rigid

@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "checkpoint.hpp"
+#include "csv.hpp"
 #include "json.hpp"
 
 namespace capstan {
@@ -65,7 +66,7 @@ struct CsvWriter {
   bool header;
   std::string prefix, out;
   void cell(const std::string& name, const std::string& value) {
-    out += (out.empty() ? "" : ",") + (header ? prefix + name : value);
+    out += (out.empty() ? "" : ",") + (header ? csvCell(prefix + name) : value);
   }
   template <class T>
   void field(const char* name, const T& value, Show = {}) {

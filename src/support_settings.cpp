@@ -20,9 +20,31 @@ const std::vector<std::pair<const char*, SupportSpec::Rotation>> SupportSpec::ro
 
 namespace {
 Array<double> vec3(double a, double b, double c) { return Teuchos::tuple(a, b, c); }
-const char* kCoreOnly[] = {"Axis Point", "Axis Direction", "Free Translation", "Force", "Force Ramp Time",
-                           "Rotation", "Torque", "Torque Ramp Time", "Angular Velocity"};
+// The parameters that only some types read (Face and Type: every type).
+struct TypedParameter {
+  const char* name;
+  std::vector<const char*> types;
+};
+const std::vector<TypedParameter> kTypedParameters = {
+    {"Components", {"Roller", "Foundation", "Displacement"}},
+    {"Stiffness", {"Foundation"}},
+    {"Velocity", {"Displacement"}},
+    {"Axis Point", {"Rigid Core"}},
+    {"Axis Direction", {"Rigid Core"}},
+    {"Free Translation", {"Rigid Core"}},
+    {"Force", {"Rigid Core"}},
+    {"Force Ramp Time", {"Rigid Core"}},
+    {"Rotation", {"Rigid Core"}},
+    {"Torque", {"Rigid Core"}},
+    {"Torque Ramp Time", {"Rigid Core"}},
+    {"Angular Velocity", {"Rigid Core"}}};
 }  // namespace
+
+bool SupportSpec::readBy(const std::string& parameter, const std::string& type) {
+  for (const auto& p : kTypedParameters)
+    if (parameter == p.name) return std::find(p.types.begin(), p.types.end(), type) != p.types.end();
+  return true;
+}
 
 void SupportSpec::declare(Teuchos::ParameterList& s) {
   s.set("Face", std::string(""), "Name of the mesh face it acts on");
@@ -49,16 +71,22 @@ void SupportSpec::declare(Teuchos::ParameterList& s) {
   s.set("Angular Velocity", 0.0, "Rigid Core, Rotation = Prescribed: rad per unit time, right-hand rule");
 }
 
-void SupportSpec::rejectCoreParametersElsewhere(const Teuchos::ParameterList& sups, const ParameterReader& r) {
+void SupportSpec::rejectParametersOfOtherTypes(const Teuchos::ParameterList& sups, const ParameterReader& r) {
   for (auto it = sups.begin(); it != sups.end(); ++it) {
     const std::string name = sups.name(it);
     if (!sups.isSublist(name)) continue;  // the validator reports it
     const auto& s = sups.sublist(name);
     const std::string type = s.isType<std::string>("Type") ? s.get<std::string>("Type") : "Fixed";
-    if (type == "Rigid Core") continue;
-    for (const char* n : kCoreOnly)
-      if (s.isParameter(n))
-        r.fail("Supports/" + name + "/" + n, "is a parameter of Type = Rigid Core only, not of " + type);
+    if (std::none_of(types.begin(), types.end(), [&](const auto& t) { return type == t.first; }))
+      continue;  // the Type's own message comes first
+    for (const auto& p : kTypedParameters) {
+      if (!s.isParameter(p.name) || readBy(p.name, type)) continue;
+      std::string owners;
+      for (size_t k = 0; k < p.types.size(); ++k)
+        owners += std::string(k == 0 ? "" : k + 1 == p.types.size() ? " or " : ", ") + p.types[k];
+      r.fail("Supports/" + name + "/" + p.name,
+             "is a parameter of Type = " + owners + (p.types.size() == 1 ? " only" : "") + ", not of " + type);
+    }
   }
 }
 

@@ -41,9 +41,12 @@ struct SupportSpec {
 
   // The template every support sublist is checked against.
   static void declare(Teuchos::ParameterList& support);
-  // Rigid Core parameters on another type would be silently ignored (most
-  // likely a misspelled Type): an error, checked before defaults fill in.
-  static void rejectCoreParametersElsewhere(const Teuchos::ParameterList& supports, const ParameterReader& r);
+  // A parameter of another type (Stiffness on a Fixed support, Components on
+  // a Rigid Core) would be silently ignored, most likely a misspelled Type or
+  // parameter: an error, checked before defaults fill in.
+  static void rejectParametersOfOtherTypes(const Teuchos::ParameterList& supports, const ParameterReader& r);
+  // Whether a support of `type` reads `parameter`.
+  static bool readBy(const std::string& parameter, const std::string& type);
   static SupportSpec parse(const Teuchos::ParameterList& support, const std::string& name,
                            const std::set<std::string>& faces, const ParameterReader& r);
   static const std::vector<std::pair<const char*, Type>> types;

@@ -272,8 +272,8 @@ TEST_F(SceneTest, MisspelledSublist) {
   expectInputError(write(sceneWith(R"X(<ParameterList name="Supports">)X", R"X(<ParameterList name="Support">)X")),
                    {"Support"});
   expectInputError(write(sceneWith(R"X(<ParameterList name="Solver">)X",
-                                   R"X(<ParameterList name="Solver"><ParameterList name="Belos"></ParameterList>)X")),
-                   {"Solver/Belos"});
+                                   R"X(<ParameterList name="Solver"><ParameterList name="Stratimikus"></ParameterList>)X")),
+                   {"Solver/Stratimikus"});
   // A sublist where a parameter belongs.
   expectInputError(write(sceneWith(R"X(<Parameter name="Title" type="string" value="test scene"/>)X",
                                    R"X(<ParameterList name="Title"></ParameterList>)X")),

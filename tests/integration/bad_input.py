@@ -241,6 +241,24 @@ case("--set: a bool that is neither", good, [good, "Output/Write Fields", "bool"
      args=["--set", "Output/Write Fields=maybe"])
 case("--set: 2 ranks, negative radius", good, [good, f"{C}/Radius"], args=["--set", f"{C}/Radius=-1"], ranks=2)
 
+# --- supports: a parameter of another type, one component held twice --------------------
+case("Stiffness on a Fixed support", good, [good, "Supports/base/Stiffness", "Foundation"],
+     args=["--set", "Supports/base/Stiffness=2"])
+case("Velocity on a Fixed support", good, [good, "Supports/base/Velocity", "Displacement"],
+     args=["--set", "Supports/base/Velocity={0, 1, 0}"])
+f = scene_file("two-supports-one-face.xml", edited(('<ParameterList name="base">',
+    '<ParameterList name="push"><Parameter name="Face" type="string" value="ymin"/>'
+    '<Parameter name="Type" type="string" value="Displacement"/><Parameter name="Components" type="string" value="y"/>'
+    '<Parameter name="Velocity" type="Array(double)" value="{0, 0.1, 0}"/></ParameterList><ParameterList name="base">')))
+case("two supports holding one face's y", f, [f, "Supports/", "/Face", "ymin"])
+# --- Solver/Belos and Solver/Ifpack2: passed through, names checked ---------------------
+KRYLOV = ["--set", "Solver/Linear Solver=GMRES", "--set", "Solver/Preconditioner=ILU"]
+case("Solver/Belos: an unknown name", good, [good, "Solver/Belos/Bogus"], args=KRYLOV + ["--set", "Solver/Belos/Bogus=1"])
+case("Solver/Belos: a word for an int", good, [good, "Solver/Belos/Num Blocks"],
+     args=KRYLOV + ["--set", "Solver/Belos/Num Blocks=many"])
+case("Solver/Ifpack2: an unknown name", good, [good, "Solver/Ifpack2", "bogus"],
+     args=KRYLOV + ["--set", "Solver/Ifpack2/bogus=0"])
+
 # --- a capstan that can never touch its faces: warning, the run goes on ------------------------
 far = scene_file("far.xml", edited((POINT, POINT.replace("{3.5, 3.75, 0}", "{3.5, 100, 0}"))))
 p, s, _ = T.run_scene(far, "far", sets=["Time/Steps=1"])
@@ -284,7 +302,11 @@ roller_case("core: negative contact smoothing", ["Capstans/capstan/Contact/Smoot
 roller_case("rigid-core parameter on a Roller", ["Supports/front/Torque=1"], "Supports/front/Torque")
 roller_case("a ring cell of half the ring or more (3 cells, a fine sector)", ["Mesh/Cells={1, 3, 1}"],
             "Mesh/Cells")
+roller_case("Components on a Rigid Core", ["Supports/core/Components=y"], "Supports/core/Components")
+roller_case("Stiffness on a Rigid Core", ["Supports/core/Stiffness=3"], "Supports/core/Stiffness")
 STEADY = T.input("pinch-roller-slice-steady.xml")
+case("steady rolling, a capstan across the annulus axis", STEADY, [STEADY, f"{C}/Axis Direction"],
+     args=["--set", f"{C}/Axis Direction={{0, 1, 0}}"])
 for pc in ("MueLu", "Jacobi"):
     case(f"steady rolling, a free-turning core, GMRES + {pc}", STEADY, [STEADY, "Solver/Preconditioner", pc],
          args=["--set", "Solver/Linear Solver=GMRES", "--set", f"Solver/Preconditioner={pc}"])

@@ -10,6 +10,7 @@ prints "Pressure Penalty", `capstan validate inputs/uniaxial.xml` exits 0 and
 writes nothing.
 """
 import os
+import re
 import sys
 
 sys.dont_write_bytecode = True  # nothing written into the source tree
@@ -120,5 +121,20 @@ T.check(p.returncode == 0, f"capstan validate inputs/uniaxial.xml: exit {p.retur
 T.check("Pressure Penalty" in p.stdout, "validate prints the resolved scene (with 'Pressure Penalty')")
 T.check(listing(work) == before, f"validate writes nothing (new: {sorted(listing(work) - before)})")
 T.check(not os.path.exists(os.path.join(work, "out")), "validate does not create the scene's Output/Directory")
+
+# validate's scene reads back: validating it prints the same scene, on a box and
+# an annulus (whose other mesh type's and support types' defaults are left out),
+# with an accuracy preset (applied once).
+for name, sets in (("uniaxial.xml", []), ("pinch-roller-slice-steady.xml", ["--set", "Accuracy=Standard"])):
+    p = T.capstan_run(["validate", T.input(name)] + sets, cwd=work)
+    again = scene_file("validated-" + name, p.stdout)
+    q = T.capstan_run(["validate", again], cwd=work)
+    strip = lambda text: re.sub(r' id="[0-9]+"', "", text)
+    T.check(p.returncode == 0 and q.returncode == 0 and strip(p.stdout) == strip(q.stdout),
+            f"validate's {name} {' '.join(sets)} reads back to the same scene: exit {q.returncode}, "
+            f"{q.stderr.strip()[:200]}")
+    if name.startswith("pinch"):
+        T.check('name="Cells" type="Array(int)" value="{8, 128, 2}"' in q.stdout,
+                "the preset's cells once ({8, 128, 2} from {4, 64, 1})")
 
 T.finish()

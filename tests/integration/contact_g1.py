@@ -12,7 +12,10 @@ augmented Lagrangian (inputs/seed/g1.xml).
     to 1e-8 x max |sigma|, and so do the stress extrema of the mirrored components;
     the capstan's x and z forces vanish (1e-8 x |F|);
   * fields.h5 contact faces: the contact traction integrated over the faces equals the
-    force on the body, -force (1e-8), and faces clear of the capstan carry no pressure.
+    force on the body, -force (1e-8), and faces clear of the capstan carry no pressure;
+  * nip.csv: s is measured from the line of centres, on a box the perpendicular from
+    the capstan's axis to the face it presses (interface.md): at every step the rows'
+    s span -a..a symmetrically (1e-8 x a), with a the half of the step's contact_width.
 """
 import os
 import sys
@@ -98,4 +101,15 @@ if quads is not None:
     T.check(clear.any() and np.all(faces["contact_pressure"][clear] == 0),
             f"{clear.sum()} faces clear of the capstan (gap < -1e-3) carry no pressure")
     T.check(faces["contact_pressure"].max() > 0, f"peak face pressure {faces['contact_pressure'].max():.4g} > 0")
+import csv  # noqa: E402
+
+with open(os.path.join(out, "nip.csv")) as fh:
+    rows = list(csv.DictReader(fh))
+for k, st in enumerate(s["steps"], start=1):
+    sv = [float(r["s"]) for r in rows if int(r["step"]) == k]
+    half = 0.5 * st["capstans"]["capstan"]["contact_width"]
+    T.check(len(sv) > 0 and abs(min(sv) + max(sv)) <= 1e-8 * max(half, 1e-12) and abs(max(sv) - half) <= 1e-8 * half,
+            f"step {k}: nip.csv's s spans {min(sv, default=0):.9g}..{max(sv, default=0):.9g}, "
+            f"symmetric about the line of centres (half width {half:.9g})")
+
 T.finish()

@@ -8,7 +8,10 @@ x = 5.25 press the G1 block; the right one also lists xmax as a candidate face.
   * equilibrium at every step: base reaction = left force + right force (1e-8);
   * mirror symmetry about x = 3.5: the two capstan forces are mirror images (x opposite,
     y equal) to 1e-8 of |F|, with the same contact point counts;
-  * max_penetration <= 5e-5 for both.
+  * max_penetration <= 5e-5 for both;
+  * capstans may have any name (interface.md): with the left one named 'left, "A"' the
+    CSV files quote it, so history.csv's and nip.csv's rows keep their header's columns
+    and nip.csv's capstan column reads back as the name (1 step).
 """
 import os
 import sys
@@ -40,4 +43,24 @@ for st in s["steps"]:
             f"points {L['contact_points']} / {R['contact_points']}")
     T.check(max(L["max_penetration"], R["max_penetration"]) <= 5e-5,
             f"step {st['step']}: max_penetration {L['max_penetration']:.1e}, {R['max_penetration']:.1e} <= 5e-5")
+
+import csv  # noqa: E402
+
+NAME = 'left, "A"'
+with open(scene) as fh:
+    text = fh.read()
+named = T.path("two-named.xml")
+with open(named, "w") as fh:
+    fh.write(text.replace('<ParameterList name="left">', '<ParameterList name="left, &quot;A&quot;">', 1))
+p, s2, out2 = T.run_scene(named, "named", sets=["Time/Steps=1", "Output/Write Fields=false"])
+if s2 is not None:
+    T.check(NAME in s2["steps"][0]["capstans"], f"summary.json names the capstan {NAME!r}")
+    for name in ("history.csv", "nip.csv"):
+        with open(os.path.join(out2, name)) as fh:
+            rows = list(csv.reader(fh))
+        T.check(len(rows) > 1 and all(len(r) == len(rows[0]) for r in rows),
+                f"{name}: every row has the header's {len(rows[0])} columns")
+    with open(os.path.join(out2, "nip.csv")) as fh:
+        names = {r["capstan"] for r in csv.DictReader(fh)}
+    T.check(names == {NAME, "right"}, f"nip.csv's capstans read back: {sorted(names)}")
 T.finish()
