@@ -112,10 +112,14 @@ class AnnulusGenerator : public MeshGenerator {
   static int sectorCells(int nt, const std::array<double, 3>& sector) {
     return sector[1] > 0 ? std::clamp(int(std::lround(sector[2] * nt)), 1, nt - 1) : 0;
   }
-  // The widest ring cell, in degrees (the scene's check; no allocation).
+  // The widest and the narrowest ring cell, in degrees (the scene's checks; no allocation).
   static double widestRingCellDegrees(int nt, const std::array<double, 3>& sector) {
     const int m = sectorCells(nt, sector);
     return m == 0 ? 360.0 / nt : std::max(sector[1] / m, (360 - sector[1]) / (nt - m));
+  }
+  static double narrowestRingCellDegrees(int nt, const std::array<double, 3>& sector) {
+    const int m = sectorCells(nt, sector);
+    return m == 0 ? 360.0 / nt : std::min(sector[1] / m, (360 - sector[1]) / (nt - m));
   }
 
  private:

@@ -558,6 +558,67 @@ void applyAccuracyPreset(ParameterList& user, const Validator& v) {
 
 }  // namespace
 
+// Numbers far outside any physical scale (c = 1e300, a Radius of 1e300, a
+// Length of 1e-300) overflow or vanish in the products the kernels form and
+// left NaN in the outputs: capstan computes with non-zero magnitudes between
+// kSmallest and kLargest (the shipped scenes and tests use 1e-15 to 1e3).
+// Directions are scaled to unit length first, whatever their size.
+constexpr double kSmallest = 1e-25, kLargest = 1e25;
+
+static void rejectMagnitudesOutOfRange(const ParameterList& list, const std::string& path, const Validator& v) {
+  for (auto it = list.begin(); it != list.end(); ++it) {
+    const std::string name = list.name(it), here = path.empty() ? name : path + "/" + name;
+    const auto& entry = list.entry(it);
+    if (entry.isList()) {
+      if (!kPassThrough.count(name)) rejectMagnitudesOutOfRange(list.sublist(name), here, v);
+      continue;
+    }
+    std::vector<double> values;
+    if (name == "Axis Direction") continue;
+    if (entry.isType<double>()) values.push_back(Teuchos::getValue<double>(entry));
+    else if (entry.isType<Array<double>>()) {
+      const auto& a = Teuchos::getValue<Array<double>>(entry);
+      values.assign(a.begin(), a.end());
+    }
+    for (double x : values)
+      if (std::isfinite(x) && x != 0 && !(std::fabs(x) >= kSmallest && std::fabs(x) <= kLargest))
+        v.fail(here, shortest(x) + " is outside the magnitudes capstan computes with (0, or " + shortest(kSmallest) +
+                         " to " + shortest(kLargest) + " in size)");
+  }
+}
+
+// A cell far thinner in one direction than in another (a Length of 1e-20 on
+// a unit ring, an Outer Cell Ratio of 1e-20, a Fine Sector of 1e-20 degrees)
+// makes its Jacobian singular to round-off: the stresses came out NaN.
+constexpr double kFlattestCell = 1e-6;
+
+static void rejectFlatCells(const MeshSpec& m, const Validator& v) {
+  double lo = 1e300, hi = 0;  // the smallest and largest cell edge
+  auto take = [&](double h) { lo = std::min(lo, h), hi = std::max(hi, h); };
+  std::string which = "Mesh/Cells";
+  if (m.type == MeshSpec::Type::Box) {
+    for (int d = 0; d < 3; ++d) take((m.max[d] - m.min[d]) / m.cells[d]);
+  } else {
+    // Radial thicknesses t0 q^k (q^(n-1) = Outer Cell Ratio), the ring cells'
+    // arcs on the inner and outer faces, the axial length.
+    const int nr = m.cells[0];
+    const double q = nr > 1 ? std::pow(m.outerCellRatio, 1.0 / (nr - 1)) : 1.0;
+    double sum = 0;
+    for (int k = 0; k < nr; ++k) sum += std::pow(q, k);
+    const double t0 = (m.outerRadius - m.innerRadius) / sum;
+    take(t0), take(t0 * std::pow(q, nr - 1));
+    const double degree = 3.14159265358979323846 / 180;
+    take(m.innerRadius * degree * AnnulusGenerator::narrowestRingCellDegrees(m.cells[1], m.fineSector));
+    take(m.outerRadius * degree * AnnulusGenerator::widestRingCellDegrees(m.cells[1], m.fineSector));
+    take(m.length / m.cells[2]);
+    which = "Mesh";
+  }
+  if (!(lo >= kFlattestCell * hi))
+    v.fail(which, "cells " + brief(hi / lo) + " times longer in one direction than in another (at most " +
+                      shortest(1 / kFlattestCell) + "): check the sizes, Cells" +
+                      (m.type == MeshSpec::Type::Box ? std::string() : ", Outer Cell Ratio and Fine Sector"));
+}
+
 // A mesh parameter of the other mesh type would be silently ignored: most likely
 // a forgotten or misspelled Mesh/Type, so it is an error. Checked on the user's
 // list, before defaults fill in every parameter of both types.
@@ -697,6 +758,7 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
   rejectOtherMeshTypeParameters(*user, v);
   if (user->isSublist("Supports")) SupportSpec::rejectParametersOfOtherTypes(user->sublist("Supports"), v);
   v.check(*user, valid, "");
+  rejectMagnitudesOutOfRange(*user, "", v);
 
   Scene sc;
   sc.file = file;
@@ -750,6 +812,7 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
     m.max = {m.center[0] + m.outerRadius, m.center[1] + m.outerRadius, m.center[2] + m.length};
     nodes = double(m.cells[0] + 1.0) * m.cells[1] * (m.cells[2] + 1.0);
   }
+  rejectFlatCells(sc.mesh, v);
   // Local dof ids are ints: 3 x nodes must stay below 2^31.
   if (3 * nodes > double(INT_MAX))
     v.fail("Mesh/Cells", "too many cells: " + shortest(nodes) + " nodes, capstan indexes at most 2^31 / 3");

@@ -9,8 +9,10 @@ must stay empty. Classes: wrong types, out-of-range values, wrong array lengths,
 unknown face names, a zero axis direction, Radius <= 0, malformed XML (unclosed,
 mismatched, duplicated, too deeply nested, unknown elements), an empty file,
 binary garbage, a missing scene file, an output directory under a regular file,
-bad NOX and Stratimikos sublists (MueLu's own parameters too, MUMPS' Precision), a mesh with fewer cells than ranks, and bad
---set values.
+bad NOX, Stratimikos, Belos and Ifpack2 sublists (MueLu's own parameters too, MUMPS'
+Precision), a mesh with fewer cells than ranks, numbers beyond the magnitudes capstan
+computes with (1e-25 to 1e25), cells flatter than 1e-6, parameters of another support
+type, two supports prescribing one component, and bad --set values.
 
 An output directory another run is writing to: exit 1, the message names the file,
 Output/Directory and the other run; the other run ends as it would have, its
@@ -302,6 +304,10 @@ roller_case("core: negative contact smoothing", ["Capstans/capstan/Contact/Smoot
 roller_case("rigid-core parameter on a Roller", ["Supports/front/Torque=1"], "Supports/front/Torque")
 roller_case("a ring cell of half the ring or more (3 cells, a fine sector)", ["Mesh/Cells={1, 3, 1}"],
             "Mesh/Cells")
+roller_case("a magnitude beyond 1e25 (c = 1e300)", ["Material/c=1e300"], "Material/c")
+roller_case("a magnitude below 1e-25 (Length = 1e-300)", ["Mesh/Length=1e-300"], "Mesh/Length")
+roller_case("flat cells (Outer Cell Ratio 1e-20)", ["Mesh/Outer Cell Ratio=1e-20"], "Mesh")
+roller_case("flat cells (a Fine Sector of 1e-20 degrees)", ["Mesh/Fine Sector={-90, 1e-20, 0.5}"], "Mesh")
 roller_case("Components on a Rigid Core", ["Supports/core/Components=y"], "Supports/core/Components")
 roller_case("Stiffness on a Rigid Core", ["Supports/core/Stiffness=3"], "Supports/core/Stiffness")
 STEADY = T.input("pinch-roller-slice-steady.xml")
