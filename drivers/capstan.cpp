@@ -53,14 +53,15 @@ bool parse(int argc, char** argv, Args& a, std::string& error) {
   for (int i = 2; i < argc; ++i) {
     const std::string s = argv[i];
     auto value = [&](const char* flag) {
-      if (i + 1 >= argc) throw std::runtime_error(std::string(flag) + " needs a value");
+      if (i + 1 >= argc || argv[i + 1][0] == '\0') throw std::runtime_error(std::string(flag) + " needs a value");
       return std::string(argv[++i]);
     };
     try {
       if (s == "--output") a.output = value("--output");
       else if (s == "--set") a.sets.push_back(value("--set"));
       else if (s.rfind("--set=", 0) == 0) a.sets.push_back(s.substr(6));
-      else if (s.rfind("--output=", 0) == 0) a.output = s.substr(9);
+      else if (s.rfind("--output=", 0) == 0 && s.size() > 9) a.output = s.substr(9);
+      else if (s == "--output=") throw std::runtime_error("--output needs a value");
       else if (s == "--restart") a.restart = value("--restart");
       else if (s.rfind("--restart=", 0) == 0) a.restart = s.substr(10);
       else if (s == "--quiet") a.quiet = true;

@@ -6,7 +6,8 @@
 // complete. The files hold plain values in the machine's byte order (a
 // checkpoint is read back by the same build), each value keyed by global ids
 // (node ids; an entity's node ids), so a restart can check that it puts every
-// value where it was taken from.
+// value where it was taken from. The file ends with a checksum of the rest
+// (FNV-1a, 64 bits): a damaged file is refused before any value is used.
 #pragma once
 
 #include <cstdio>
@@ -21,7 +22,13 @@ namespace capstan::checkpoint {
 
 namespace fs = std::filesystem;
 
-inline const char* kMagic = "capstan checkpoint 4";
+inline const char* kMagic = "capstan checkpoint 5";
+
+inline unsigned long long fnv1a(const char* p, size_t n) {
+  unsigned long long h = 14695981039346656037ull;
+  for (size_t i = 0; i < n; ++i) h = (h ^ (unsigned char)p[i]) * 1099511628211ull;
+  return h;
+}
 
 class Writer {
  public:
@@ -40,7 +47,11 @@ class Writer {
     put<unsigned long long>(v.size());
     buffer_.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
   }
-  const std::string& bytes() const { return buffer_; }
+  // The file's bytes: the values, then their checksum.
+  std::string bytes() const {
+    const unsigned long long h = fnv1a(buffer_.data(), buffer_.size());
+    return buffer_ + std::string(reinterpret_cast<const char*>(&h), sizeof h);
+  }
 
  private:
   std::string buffer_;
@@ -49,7 +60,13 @@ class Writer {
 // Reads what Writer wrote; throws std::runtime_error on a short or damaged file.
 class Reader {
  public:
-  explicit Reader(std::string bytes) : buffer_(std::move(bytes)) {}
+  explicit Reader(std::string bytes) : buffer_(std::move(bytes)) {
+    unsigned long long h;
+    if (buffer_.size() < sizeof h) throw std::runtime_error("truncated");
+    std::memcpy(&h, buffer_.data() + buffer_.size() - sizeof h, sizeof h);
+    buffer_.resize(buffer_.size() - sizeof h);
+    if (h != fnv1a(buffer_.data(), buffer_.size())) throw std::runtime_error("damaged (its checksum does not match)");
+  }
   template <class T>
   T get() {
     static_assert(std::is_trivially_copyable_v<T>);

@@ -25,6 +25,7 @@ class LoadStepper {
   // smallest sub-step; u and the effects are back at the step's start.
   bool advance(StepRecord& rec, std::string& failure);
   double time() const { return tDone_; }
+  Predictors& predictors() { return predictors_; }
 
  private:
   bool solveIncrement(double t0, double t1, StepRecord& rec, std::string& failure);

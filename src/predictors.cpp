@@ -67,6 +67,25 @@ void Predictors::remember(const Vector& before, double tBefore, std::vector<doub
   previousRotation_ = std::move(rotationsBefore);
 }
 
+Predictors::Memory Predictors::memory() const {
+  Memory memory;
+  if (previous_.is_null()) return memory;
+  const auto data = previous_->getData();
+  memory.u.assign(data.begin(), data.end());
+  memory.t = tPrevious_;
+  memory.rotations = previousRotation_;
+  return memory;
+}
+
+void Predictors::recall(const Memory& memory) {
+  if (memory.u.empty()) return;
+  previous_ = rcp(new Vector(m_.u->getMap()));
+  auto data = previous_->getDataNonConst();
+  std::copy(memory.u.begin(), memory.u.end(), data.begin());
+  tPrevious_ = memory.t;
+  previousRotation_ = memory.rotations;
+}
+
 bool Predictors::extrapolate(double t0, double t, double bare, Vector& f) {
   Vector trial(*m_.u, Teuchos::Copy);
   trial.update(-(t - t0) / (t0 - tPrevious_), *previous_, 1.0 + (t - t0) / (t0 - tPrevious_));

@@ -26,6 +26,14 @@ class Predictors {
   // The state before the increment that just converged (u, its time and the
   // cores' rotations): the base of the rolling extrapolation.
   void remember(const Vector& before, double tBefore, std::vector<double> rotationsBefore);
+  // What remember() holds, for a checkpoint (u's local values, as u's; empty
+  // before the first increment), and its return on a restart.
+  struct Memory {
+    std::vector<double> u, rotations;
+    double t = 0;
+  };
+  Memory memory() const;
+  void recall(const Memory& memory);
   // Steady rolling's start from rest: the tangent predictor alone, at the
   // loads of time t (no rolling measures: the steady mesh does not turn).
   void linearResponse(double t, StepRecord& rec);

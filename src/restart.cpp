@@ -33,7 +33,7 @@ std::vector<long long> entityKeys(const Mesh& mesh, const Effect& e, int& perEnt
 }
 
 std::string checkpointBytes(const Model& model, const Timings& timings, const std::vector<StepRecord>& steps,
-                            int step, double time) {
+                            int step, double time, const Predictors::Memory& predictors) {
   const auto& scene = model.scene;
   const auto& mesh = model.mesh;
   checkpoint::Writer w;
@@ -57,6 +57,8 @@ std::string checkpointBytes(const Model& model, const Timings& timings, const st
     w.put(hostValues(e->multipliers()));
     w.put(hostValues(e->history()));
   }
+  // The predictors' base state, in u's layout (the node ids above).
+  w.put(predictors.u), w.put(predictors.rotations), w.put<double>(predictors.t);
   // Rank 0: the step records, and what the summary adds up over the runs.
   if (model.rank0) {
     w.put<int>(int(steps.size()));
@@ -71,7 +73,7 @@ std::string checkpointBytes(const Model& model, const Timings& timings, const st
 }  // namespace
 
 void writeCheckpoint(const Model& model, Outputs& outputs, const std::vector<StepRecord>& steps, int step,
-                     double time) {
+                     double time, const Predictors::Memory& predictors) {
   const auto t = std::chrono::steady_clock::now();
   const Comm& comm = *model.comm;
   const fs::path root = outputs.directory() / "checkpoint";
@@ -89,7 +91,7 @@ void writeCheckpoint(const Model& model, Outputs& outputs, const std::vector<Ste
   agreeRuntime(comm, error);
   try {
     writeAtomically(tmp / checkpoint::rankFile(comm.getRank()),
-                    checkpointBytes(model, outputs.timings(), steps, step, time));
+                    checkpointBytes(model, outputs.timings(), steps, step, time, predictors));
   } catch (const std::exception& e) {
     error = std::string("checkpoint: ") + e.what();
   }
@@ -258,6 +260,17 @@ void Restart::restore(Model& model, std::vector<StepRecord>& steps, Timings& ear
       put(e.multipliers(), sv.multipliers, "multipliers");
       put(e.history(), sv.history, "history values");
     }
+    // The predictors' base state: u's layout, its node ids checked above.
+    const auto previous = in.getVector<double>();
+    predictors_.rotations = in.getVector<double>();
+    predictors_.t = in.get<double>();
+    if (!previous.empty() && previous.size() != ud.size())
+      throw std::runtime_error("holds " + std::to_string(previous.size()) + " predictor values, u has " +
+                               std::to_string(ud.size()));
+    predictors_.u.assign(previous.size(), 0.0);
+    for (size_t i = 0; i < gids.size() && !previous.empty(); ++i)
+      for (int c = 0; c < 3; ++c) predictors_.u[3 * owned.at(gids[i]) + c] = previous[3 * i + c];
+    for (size_t j = 3 * gids.size(); j < previous.size(); ++j) predictors_.u[j] = previous[j];
     if (model.rank0) {
       const int n = in.get<int>();
       for (int i = 0; i < n; ++i) steps.push_back(checkpoint::get(in));

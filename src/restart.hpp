@@ -3,12 +3,11 @@
 // continuation needs: u, every effect's multipliers (pressure anchors,
 // contact and tangential multipliers) and history (friction's positions,
 // tractions and stick states), the step and its time, and the step records
-// and timings for summary.json and history.csv. The step size needs no
-// saving: every step starts at the full Time/Step Size (cuts last only
-// within a step), and nothing else carries over between steps (each Newton
-// solve, Anderson mixing and preconditioner is built afresh). The rolling
-// predictors' last increment is not saved: a restarted rolling run starts
-// them afresh and may differ from an uninterrupted one.
+// and timings for summary.json and history.csv, and the rolling predictors'
+// last increment (the state before it: Predictors::Memory). The step size
+// needs no saving: every step starts at the full Time/Step Size (cuts last
+// only within a step), and nothing else carries over between steps (each
+// Newton solve, Anderson mixing and preconditioner is built afresh).
 #pragma once
 
 #include <filesystem>
@@ -19,6 +18,7 @@
 #include "checkpoint.hpp"
 #include "model.hpp"
 #include "outputs.hpp"
+#include "predictors.hpp"
 #include "step_record.hpp"
 
 namespace capstan {
@@ -26,7 +26,7 @@ namespace capstan {
 // Writes OUTDIR/checkpoint/step-<k>/ (collective; one file per rank, published
 // by a rename when all are written), then removes the older ones.
 void writeCheckpoint(const Model& model, Outputs& outputs, const std::vector<StepRecord>& steps, int step,
-                     double time);
+                     double time, const Predictors::Memory& predictors);
 
 // Removes the checkpoints in OUTDIR/checkpoint but `keep` (rank 0): an earlier
 // run's do not belong to this one.
@@ -46,6 +46,8 @@ class Restart {
   // records and the earlier runs' timings into the built run; checks that
   // fields.h5 is there to continue. Throws InputError where it does not fit.
   void restore(Model& model, std::vector<StepRecord>& steps, Timings& earlier);
+  // The predictors' memory read by restore().
+  const Predictors::Memory& predictors() const { return predictors_; }
   // Continues the earlier run's fields.h5 in `outputDir` (a copy when this run
   // writes elsewhere).
   void continueFields(const Model& model, const std::filesystem::path& outputDir) const;
@@ -60,6 +62,7 @@ class Restart {
   int step_ = 0;
   double time_ = 0;
   std::unique_ptr<checkpoint::Reader> in_; // positioned after the header
+  Predictors::Memory predictors_;
 };
 
 }  // namespace capstan

@@ -32,6 +32,7 @@ class Simulation {
     if (restart_) restart_->restore(*model_, steps_, outputs_->earlier);
     openOutputs();
     LoadStepper stepper(*model_, log_, options_.checkTangent, restart_ ? restart_->time() : 0.0);
+    if (restart_) stepper.predictors().recall(restart_->predictors());
     std::string failure;
     bool ok = true;
     for (int step = restart_ ? restart_->step() + 1 : 1; step <= scene_.steps && ok; ++step) {
@@ -41,7 +42,7 @@ class Simulation {
       rec.step = step;
       rec.time = step * scene_.stepSize;
       ok = stepper.advance(rec, failure);
-      if (ok) finishStep(rec, stepper.time(), stepStart);
+      if (ok) finishStep(rec, stepper, stepStart);
     }
     if (!ok) model_->assembly->evaluate(*model_->u, nullptr, nullptr);  // final figures: last converged state
     outputs_->writeHistory(steps_);
@@ -73,7 +74,7 @@ class Simulation {
 
   // A converged step: its figures, outputs, the effects' history moved on,
   // a checkpoint when due, the progress lines.
-  void finishStep(StepRecord& rec, double time, Clock::time_point stepStart) {
+  void finishStep(StepRecord& rec, LoadStepper& stepper, Clock::time_point stepStart) {
     measureStep(*model_, steps_, rec);
     rec.wall = since(stepStart);
     steps_.push_back(rec);
@@ -82,7 +83,7 @@ class Simulation {
     for (const auto& e : model_->effects()) e->commit(model_->assembly->positions());
     outputs_->writeHistory(steps_);
     if (scene_.checkpointEvery > 0 && rec.step % scene_.checkpointEvery == 0)
-      writeCheckpoint(*model_, *outputs_, steps_, rec.step, time);
+      writeCheckpoint(*model_, *outputs_, steps_, rec.step, stepper.time(), stepper.predictors().memory());
     for (const auto& line : progressLines(rec, scene_.steps, outputs_->timings().total)) log_.progress(line);
   }
 
