@@ -22,13 +22,20 @@ std::vector<double> hostValues(const Kokkos::View<double*>& v) {
 }
 
 // Node ids of each entity of effect e (nodes per entity in `perEntity`): the
-// keys that put each saved value back where it was taken from.
+// keys that put each saved value back where it was taken from. A block of
+// dofs past the mesh's nodes (a rigid core's: steady friction's angular
+// velocity) is keyed -1 - its place after them, the same in every run of
+// the scene on as many ranks.
 std::vector<long long> entityKeys(const Mesh& mesh, const Effect& e, int& perEntity) {
   auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), e.local().dofs);
   perEntity = int(dofs.extent(1) / 3);
+  const long long nodes = (long long)mesh.nodeGids.size();
   std::vector<long long> keys(dofs.extent(0) * perEntity);
   for (size_t i = 0; i < dofs.extent(0); ++i)
-    for (int a = 0; a < perEntity; ++a) keys[i * perEntity + a] = mesh.nodeGids[dofs(i, 3 * a) / 3];
+    for (int a = 0; a < perEntity; ++a) {
+      const long long block = dofs(i, 3 * a) / 3;
+      keys[i * perEntity + a] = block < nodes ? mesh.nodeGids[block] : -1 - (block - nodes);
+    }
   return keys;
 }
 

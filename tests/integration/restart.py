@@ -22,7 +22,8 @@ uninterrupted run's to 1e-10 relative.
 The free roller slice (inputs/pinch-roller-slice.xml, 2 ranks) finished with a
 checkpoint at step 4 and restarted there: its rolling predictors extrapolate the
 last increment, which the checkpoint carries, so steps 5 and 6 equal the
-uninterrupted run's to 1e-10 too.
+uninterrupted run's to 1e-10 too; the same for the steady braked slice (its
+friction entities include the core's angular velocity).
 
 Bad restarts exit 1, name the scene file and what does not fit, and leave the
 output directory as it was: another mesh (Mesh/Cells), another step size
@@ -322,6 +323,17 @@ _, s, out4 = T.run_scene(SLICE, "slice-finished-2", sets=[f"Time/Steps={STEPS}",
 restart("rolling slice, 2 ranks, from a finished run", out4, [f"Time/Steps={STEPS}"], 2, 4, scene=SLICE)
 compare("rolling slice, 2 ranks, from a finished run", ref4, out4, scene=SLICE)
 print(f"    rolling slice: {time.time() - t0:.1f} s")
+# Steady rolling (the braked slice's sweep, 2 ranks): steady friction's entities
+# hold the core's angular velocity (a block past the mesh's nodes), keyed apart
+# from the nodes (a restart read past the node ids and refused its own checkpoint).
+t0 = time.time()
+STEADY = T.input("pinch-roller-braked-steady.xml")
+_, s, ref5 = T.run_scene(STEADY, "steady-uninterrupted-2", sets=[f"Time/Steps={STEPS}"], ranks=2)
+_, s, out5 = T.run_scene(STEADY, "steady-finished-2", sets=[f"Time/Steps={STEPS}", "Output/Checkpoint Every=4"],
+                         ranks=2)
+restart("steady braked slice, 2 ranks, from a finished run", out5, [f"Time/Steps={STEPS}"], 2, 4, scene=STEADY)
+compare("steady braked slice, 2 ranks, from a finished run", ref5, out5, scene=STEADY)
+print(f"    steady slice: {time.time() - t0:.1f} s")
 
 # --- bad restarts ------------------------------------------------------------
 bad_restart("another mesh", out1, ["--set", "Mesh/Cells={40,4,2}"], 1, [SCENE, "Mesh/Cells"])
