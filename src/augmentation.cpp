@@ -368,14 +368,16 @@ bool AugmentationLoop::saddlePointPressureStep(double t, Vector& f, bool volumeM
   const double volumeTarget = volumeMet || monolithic ? 0.0 : kPressureStepVolumeMargin * bricks.constraintTolerance();
   PressureStep::Result step;
   const auto stepStart = Clock::now();
+  std::string failure;
   try {
     const bool onNewtonsFactors = !monolithic && m_.scene.solver.pressureStepOnNewtonsFactors;
     step = m_.pressureStep->solve(*W, m_.newton->approximateInverse(onNewtonsFactors), f,
                                   monolithic ? kMonolithicStepTolerance : kPressureStepTolerance, volumeTarget,
                                   m_.scene.solver.maxLinearIterations, dx, pressureStepDmu_);
-  } catch (const std::exception&) {  // e.g. a preconditioner that cannot be built: a plain pass
-    return false;
+  } catch (const std::exception& e) {  // e.g. a preconditioner that cannot be built: a plain pass
+    failure = e.what();
   }
+  if (!m_.newton->agree(failure).empty()) return false;
   rec.linear += step.iterations;
   rec.pressureStep += step.iterations;
   if (log_.on("newton"))

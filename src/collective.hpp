@@ -25,4 +25,28 @@ void agreeRuntime(const Comm& comm, std::string error);
 // Rank 0's string on every rank.
 std::string broadcastString(const Comm& comm, std::string s);
 
+// Whether a step that can fail on some ranks alone (an exception inside a
+// Trilinos solver) failed anywhere, agreed on a communicator of its own. A
+// rank-local exception inside a collective call leaves the other ranks
+// inside that call for good: a failed rank waits for the others at most
+// `patience` seconds, then reports and ends the job (MPI_Abort, exit 2)
+// rather than hang. Construct it on every rank at once (it duplicates the
+// communicator).
+class FailureAgreement {
+ public:
+  explicit FailureAgreement(const RCP<const Comm>& comm);
+  ~FailureAgreement();
+  FailureAgreement(const FailureAgreement&) = delete;
+  FailureAgreement& operator=(const FailureAgreement&) = delete;
+  // The lowest failed rank's `failure` on every rank; empty where none failed.
+  std::string agree(const std::string& failure, double patience = kPatience) const;
+  // Long enough for any rank still in local work (an assembly, a factorisation
+  // of its own) to arrive; the time a stuck job takes to end.
+  static constexpr double kPatience = 60;
+
+ private:
+  MPI_Comm comm_ = MPI_COMM_NULL;
+  int rank_ = 0, size_ = 1;
+};
+
 }  // namespace capstan

@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "collective.hpp"
 #include "errors.hpp"
 #include "linear_solver_factories.hpp"
 #include "mumps_solve_factory.hpp"
@@ -218,7 +219,9 @@ struct NewtonSolver::Impl {
   std::unique_ptr<LagPolicy> lag;
   double linearSeconds = 0;
   double preconditionerSeconds = 0;  // part of linearSeconds
-  Impl(Assembly& a, const SolverSettings& s) : assembly(a), solver(s) {}
+  // A solver's exception on one rank alone, made every rank's (or the job's end).
+  FailureAgreement agreement;
+  Impl(Assembly& a, const SolverSettings& s) : assembly(a), solver(s), agreement(a.dofMap()->getComm()) {}
 
   RCP<Teuchos::ParameterList> noxParameters(const RCP<NOX::Observer>& observer) const {
     auto params = Teuchos::parameterList("NOX");
@@ -360,6 +363,7 @@ int NewtonSolver::linearSolve(const Vector& b, Vector& x, double tolerance, Prec
   auto bt = Thyra::createConstVector(Teuchos::rcpFromRef(b), space);
   auto xt = Thyra::createVector(Teuchos::rcpFromRef(x), space);
   int iterations = -1;
+  std::string failure;  // an exception's, on this rank
   try {  // the factorisation (a direct solver's) happens here, and fails on a singular W
     RCP<Thyra::LinearOpWithSolveBase<double>> lows;
     const bool asBuilt = preconditioner == Preconditioner::KeptAsBuilt && keepsFactorisation();
@@ -383,9 +387,10 @@ int NewtonSolver::linearSolve(const Vector& b, Vector& x, double tolerance, Prec
     const auto status = Thyra::solve<double>(*lows, Thyra::NOTRANS, *bt, xt.ptr(), Teuchos::constPtr(criteria));
     if (status.solveStatus == Thyra::SOLVE_STATUS_CONVERGED || status.solveStatus == Thyra::SOLVE_STATUS_UNKNOWN)
       iterations = status.extraParameters.is_null() ? 0 : status.extraParameters->get("Iteration Count", 0);
-  } catch (const std::exception&) {
-    iterations = -1;
+  } catch (const std::exception& e) {
+    failure = "linear solver error: " + trilinosMessage(e.what());
   }
+  if (!impl_->agreement.agree(failure).empty()) iterations = -1;
   impl_->linearSeconds += timer.seconds();
   return iterations;
 }
@@ -455,6 +460,7 @@ void NewtonSolver::rebuildPreconditioner() {
 }
 
 double NewtonSolver::linearSolveSeconds() const { return impl_->linearSeconds; }
+std::string NewtonSolver::agree(const std::string& failure) const { return impl_->agreement.agree(failure); }
 double NewtonSolver::preconditionerSeconds() const { return impl_->preconditionerSeconds; }
 const Teuchos::ParameterList& NewtonSolver::linearSolverParameters() const { return impl_->strat; }
 
@@ -594,6 +600,7 @@ NewtonResult NewtonSolver::solve(Vector& u, double tolerance) {
   } catch (const std::exception& e) {
     r.failure = "nonlinear solver error: " + trilinosMessage(e.what());  // less Teuchos' throw details
   }
+  r.failure = impl_->agreement.agree(r.failure);
   auto& out = params->sublist("Direction").sublist("Newton").sublist("Linear Solver").sublist("Output");
   r.linearIterations = out.get("Cumulative Iteration Count", 0);
   r.residualHistory = history->norms;

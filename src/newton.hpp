@@ -79,6 +79,10 @@ class NewtonSolver {
   // as preconditioner set-up); its applications are the caller's to time.
   std::function<void(const Vector& r, Vector& z)> approximateInverse(bool afterNewton = false);
   double linearSolveSeconds() const;
+  // A failure that may be this rank's alone (a solver's exception), agreed
+  // over the ranks: the lowest failed rank's message, empty where none failed
+  // (FailureAgreement: a job whose other ranks are stuck in the solver ends).
+  std::string agree(const std::string& failure) const;
   // The part of linearSolveSeconds() spent setting up preconditioners.
   double preconditionerSeconds() const;
   // Preconditioners Newton has built so far (the lagged one; CAPSTAN_NEWTON_LOG).

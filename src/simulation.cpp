@@ -82,6 +82,11 @@ class Simulation {
     outputs_->writeNip(rec.step);
     for (const auto& e : model_->effects()) e->commit(model_->assembly->positions());
     outputs_->writeHistory(steps_);
+    // A run that ends before its own summary (killed, or MPI_Abort where a
+    // failure on one rank alone left the others stuck) leaves this one.
+    outputs_->writeSummary(steps_, false,
+                           "the run stopped after step " + std::to_string(rec.step) + " of " +
+                               std::to_string(scene_.steps) + " without finishing its summary (killed, or see its stderr)");
     if (scene_.checkpointEvery > 0 && rec.step % scene_.checkpointEvery == 0)
       writeCheckpoint(*model_, *outputs_, steps_, rec.step, stepper.time(), stepper.predictors().memory());
     for (const auto& line : progressLines(rec, scene_.steps, outputs_->timings().total)) log_.progress(line);

@@ -144,7 +144,8 @@ def run_and_kill(tag, sets, ranks, after_step):
 
 def killed_outputs_readable(tag, out, k):
     """What a killed run leaves: fields.h5 opens and holds steps 0..k at least;
-    fields.xmf parses and indexes only steps fields.h5 holds; history.csv rows >= k."""
+    fields.xmf parses and indexes only steps fields.h5 holds; history.csv rows >= k;
+    summary.json lists the converged steps (>= k) and says the run stopped."""
     import h5py
     try:
         with h5py.File(os.path.join(out, "fields.h5"), "r") as f:
@@ -165,6 +166,18 @@ def killed_outputs_readable(tag, out, k):
     with open(os.path.join(out, "history.csv")) as f:
         rows = list(csv.DictReader(f))
     T.check(len(rows) >= k, f"{tag}: killed run's history.csv has {len(rows)} rows (>= {k})")
+    # summary.json is rewritten after every step: the killed run's lists its converged steps.
+    import json
+    try:
+        with open(os.path.join(out, "summary.json")) as f:
+            summary = json.load(f)
+        listed = [st["step"] for st in summary["steps"]]
+        T.check(summary["converged"] is False and "stopped after step" in (summary["failure"] or "")
+                and listed == list(range(1, len(listed) + 1)) and len(listed) >= k,
+                f"{tag}: killed run's summary.json lists steps 1..{len(listed)} (>= {k}), not converged: "
+                f"{summary['failure']!r}")
+    except (OSError, ValueError, KeyError) as e:
+        T.check(False, f"{tag}: killed run's summary.json readable: {e}")
 
 
 def restart(tag, out, sets, ranks, k, scene=None):
