@@ -245,7 +245,9 @@ void Restart::restore(Model& model, std::vector<StepRecord>& steps, Timings& ear
       const size_t entities = perEntity ? keys.size() / perEntity : 0;
       if (perEntity != sv.perEntity || keys.size() != sv.keys.size())
         throw std::runtime_error(e.name() + ": " + std::to_string(sv.keys.size() / std::max(sv.perEntity, 1)) +
-                                 " entities, the scene has " + std::to_string(entities));
+                                 " entities of " + std::to_string(sv.perEntity) + " nodes, the scene has " +
+                                 std::to_string(entities) + " of " + std::to_string(perEntity) +
+                                 " (another analysis or friction law)");
       std::map<std::vector<long long>, size_t> index;
       for (size_t k = 0; k < entities; ++k)
         index[std::vector<long long>(keys.begin() + k * perEntity, keys.begin() + (k + 1) * perEntity)] = k;

@@ -603,8 +603,7 @@ static void rejectFlatCells(const MeshSpec& m, const Validator& v) {
     // arcs on the inner and outer faces, the axial length.
     const int nr = m.cells[0];
     const double q = nr > 1 ? std::pow(m.outerCellRatio, 1.0 / (nr - 1)) : 1.0;
-    double sum = 0;
-    for (int k = 0; k < nr; ++k) sum += std::pow(q, k);
+    const double sum = std::fabs(q - 1) < 1e-12 ? nr : (std::pow(q, nr) - 1) / (q - 1);  // sum of q^k, k < nr
     const double t0 = (m.outerRadius - m.innerRadius) / sum;
     take(t0), take(t0 * std::pow(q, nr - 1));
     const double degree = 3.14159265358979323846 / 180;
@@ -745,6 +744,8 @@ ParameterList printableScene(const Scene& scene) {
 Scene parseScene(const std::string& content, const std::string& file, const std::vector<std::string>& sets,
                  const std::string& outputOverride) {
   Validator v{file};
+  // A UTF-8 byte-order mark before the declaration is well-formed XML.
+  if (content.rfind("\xEF\xBB\xBF", 0) == 0) return parseScene(content.substr(3), file, sets, outputOverride);
   if (content.find_first_not_of(" \t\r\n") == std::string::npos)
     throw InputError(file + ": the scene file is empty");
   for (unsigned char ch : content)
@@ -812,10 +813,10 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
     m.max = {m.center[0] + m.outerRadius, m.center[1] + m.outerRadius, m.center[2] + m.length};
     nodes = double(m.cells[0] + 1.0) * m.cells[1] * (m.cells[2] + 1.0);
   }
-  rejectFlatCells(sc.mesh, v);
   // Local dof ids are ints: 3 x nodes must stay below 2^31.
   if (3 * nodes > double(INT_MAX))
     v.fail("Mesh/Cells", "too many cells: " + shortest(nodes) + " nodes, capstan indexes at most 2^31 / 3");
+  rejectFlatCells(sc.mesh, v);
   const std::vector<std::string> faceList = sc.mesh.faceNames();
   const std::set<std::string> faceNames(faceList.begin(), faceList.end());
   std::string faceText;
