@@ -143,6 +143,19 @@ Restart::Restart(const Scene& scene, const Comm& comm, const std::string& dir)
     } else {
       found = latest.string();
       while (fs::exists(latest / checkpoint::rankFile(files))) ++files;
+      // The rank count its first file was written with: fewer files than that
+      // is a damaged checkpoint, not one of fewer ranks.
+      try {
+        std::ifstream in(latest / checkpoint::rankFile(0), std::ios::binary);
+        checkpoint::Reader rd(std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()));
+        if (rd.getString() == checkpoint::kMagic) {
+          const int written = rd.get<int>();
+          if (written != files)
+            error = where() + "the checkpoint '" + found + "' is incomplete: written on " + std::to_string(written) +
+                    " rank(s), it holds " + std::to_string(files) + " rank file(s)";
+        }
+      } catch (const std::exception&) {  // damaged: said below, file by file
+      }
     }
   }
   agreeInput(comm, error);

@@ -28,7 +28,8 @@ friction entities include the core's angular velocity).
 Bad restarts exit 1, name the scene file and what does not fit, and leave the
 output directory as it was: another mesh (Mesh/Cells), another step size
 (Time/Step Size), another rank count, a directory without a checkpoint, a
-damaged checkpoint (one byte flipped: its checksum).
+damaged checkpoint (one byte flipped: its checksum), an incomplete one (a rank's
+file removed).
 """
 import csv
 import glob
@@ -365,4 +366,11 @@ with open(rank0, "r+b") as fh:
     fh.seek(-1, os.SEEK_CUR)
     fh.write(bytes([byte[0] ^ 0xFF]))
 bad_restart("a damaged checkpoint", damaged, ["--set", f"Time/Steps={STEPS}"], 2, [SLICE, "checksum"], scene=SLICE)
+# A checkpoint that lost a rank's file: incomplete, not one of fewer ranks.
+partial = T.path("slice-partial")
+shutil.copytree(out4, partial)
+for f in glob.glob(os.path.join(partial, "checkpoint", "step-*", "rank-00001.bin")):
+    os.remove(f)
+bad_restart("a checkpoint without rank 1's file", partial, ["--set", f"Time/Steps={STEPS}"], 2,
+            [SLICE, "incomplete", "written on 2 rank(s)"], scene=SLICE)
 T.finish()
