@@ -573,8 +573,8 @@ static void rejectMagnitudesOutOfRange(const ParameterList& list, const std::str
       if (!kPassThrough.count(name)) rejectMagnitudesOutOfRange(list.sublist(name), here, v);
       continue;
     }
-    std::vector<double> values;
     if (name == "Axis Direction") continue;
+    std::vector<double> values;
     if (entry.isType<double>()) values.push_back(Teuchos::getValue<double>(entry));
     else if (entry.isType<Array<double>>()) {
       const auto& a = Teuchos::getValue<Array<double>>(entry);
@@ -618,9 +618,7 @@ static void rejectFlatCells(const MeshSpec& m, const Validator& v) {
                       (m.type == MeshSpec::Type::Box ? std::string() : ", Outer Cell Ratio and Fine Sector"));
 }
 
-// A mesh parameter of the other mesh type would be silently ignored: most likely
-// a forgotten or misspelled Mesh/Type, so it is an error. Checked on the user's
-// list, before defaults fill in every parameter of both types.
+// The mesh parameters that a mesh of `type` does not read (the other type's).
 static const std::vector<std::string>& otherMeshTypeParameters(const std::string& type) {
   static const std::vector<std::string> boxOnly = {"Min", "Max"}, none;
   static const std::vector<std::string> annulusOnly = {"Center", "Inner Radius", "Outer Radius", "Length",
@@ -628,6 +626,9 @@ static const std::vector<std::string>& otherMeshTypeParameters(const std::string
   return type == "Annulus" ? boxOnly : type == "Box" ? annulusOnly : none;
 }
 
+// A mesh parameter of the other mesh type would be silently ignored: most likely
+// a forgotten or misspelled Mesh/Type, so it is an error. Checked on the user's
+// list, before defaults fill in every parameter of both types.
 static void rejectOtherMeshTypeParameters(const ParameterList& user, const Validator& v) {
   if (!user.isSublist("Mesh")) return;
   const auto& mesh = user.sublist("Mesh");
