@@ -19,8 +19,9 @@ Reads RUN_DIR/summary.json and RUN_DIR/nip.csv and writes into --out (default RU
   the rigid-radius torque balance as references.
 - steady.md: a table per step (also printed).
 
-The scene is --scene, else summary.json's "scene" looked up near RUN_DIR, the current
-directory and the repository's inputs/ (command-line --set overrides are not seen).
+The scene is --scene, else RUN_DIR/scene.xml (the scene as the run resolved it, --set
+overrides included), else summary.json's "scene" looked up near RUN_DIR, the current
+directory and the repository's inputs/ (a run from before scene.xml).
 Without a scene the references are skipped. nip.csv rows at the same (s, z) (a node's
 points on two faces) are averaged; for a 3D run the row nearest mid-length is drawn and
 the other z rows in light colour.
@@ -87,6 +88,9 @@ def get(d, *path, default=None):
 
 
 def find_scene(run_dir, summary):
+    own = os.path.join(run_dir, "scene.xml")  # the run's resolved scene, --set overrides included
+    if os.path.isfile(own):
+        return own
     ref = summary.get("scene")
     if not ref:
         return None
@@ -198,7 +202,9 @@ def main():
     scene, scene_path = {}, args.scene
     if scene_path is None:
         scene_path = find_scene(run, summary)
-        if scene_path:
+        if scene_path and os.path.basename(scene_path) == "scene.xml" and os.path.dirname(scene_path) == run:
+            notes.append(f"scene {scene_path} (the run's own, as it resolved it)")
+        elif scene_path:
             notes.append(f"scene {scene_path} (found from summary.json's \"scene\"; --set overrides not seen)")
         else:
             notes.append(f"no scene found (summary.json scene: {summary.get('scene')!r}); pass --scene: "

@@ -19,8 +19,8 @@ Q1P0 a pressure jump pushes the node along the ring (by the jump times half the 
 element's thickness per unit length), and in the stick zone the shear is what holds the
 node: the table gives the correlation of the two's alternating parts (each less its
 1/4, 1/2, 1/4 average over the node and its ring neighbours) and their ratio. The capstan's
-axis, radius and turning sense come from the run's scene (summary.json's "scene", read
-relative to the current directory, or --scene).
+axis, radius and turning sense come from the run's scene: its scene.xml (the scene as the
+run resolved it, --set overrides included), or --scene.
 """
 import argparse
 import csv
@@ -34,7 +34,7 @@ import numpy as np
 ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
 ap.add_argument("runs", nargs="+")
 ap.add_argument("--mu", type=float, default=0.8, help="the friction coefficient (scales the figures)")
-ap.add_argument("--scene", help="the runs' scene (default: summary.json's, relative to the current directory)")
+ap.add_argument("--scene", help="the runs' scene (default: each run's scene.xml)")
 args = ap.parse_args()
 
 
@@ -96,8 +96,10 @@ def capstan_of(scene_path):
 def node_jumps(run):
     """Per sticking node with two sticking ring neighbours: the alternating parts of
     (shear, pressure jump)."""
-    with open(os.path.join(run, "summary.json")) as f:
-        scene = args.scene or json.load(f)["scene"]
+    scene = args.scene or os.path.join(run, "scene.xml")  # the run's resolved scene (capstan writes it)
+    if not os.path.exists(scene):  # a run from before scene.xml
+        with open(os.path.join(run, "summary.json")) as f:
+            scene = json.load(f)["scene"]
     a, b, radius, sense, roller = capstan_of(scene)
     with h5py.File(os.path.join(run, "fields.h5"), "r") as f:
         step = f["steps"][sorted(f["steps"].keys())[-1]]

@@ -1,6 +1,7 @@
 #include "outputs.hpp"
 
 #include <Teuchos_CommHelpers.hpp>
+#include <Teuchos_XMLParameterListHelpers.hpp>
 #include <fcntl.h>
 #include <sys/file.h>
 #include <sys/resource.h>
@@ -120,6 +121,13 @@ void Outputs::checkDirectory() {
   if (!dirOk)
     throw InputError(m_.scene.file + ": parameter 'Output/Directory': cannot write to '" + dir_.string() + "'" +
                      (dirError.empty() ? "" : ": " + dirError));
+}
+
+void Outputs::writeScene() {
+  if (!m_.rank0) return;
+  std::ostringstream xml;
+  Teuchos::writeParameterListToXmlOStream(printableScene(m_.scene), xml);
+  writeAtomically(dir_ / "scene.xml", xml.str());
 }
 
 FieldLayout Outputs::fieldLayout() const {

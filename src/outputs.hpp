@@ -47,6 +47,9 @@ class Outputs {
   // The step's fields (collective).
   void writeFields(int step, double time);
   void writeHistory(const std::vector<StepRecord>& steps);
+  // scene.xml: the scene as this run resolved it (every default, every --set),
+  // as `capstan validate` prints it: `capstan run OUT/scene.xml` runs it again.
+  void writeScene();
   // nip.csv: started (a restart keeps the earlier run's rows up to lastKept),
   // then each converged step's rows (collective).
   void openNip(int lastKept);

@@ -55,6 +55,7 @@ class Simulation {
   // The output directory, the files a restart continues, the initial state.
   void openOutputs() {
     outputs_->checkDirectory();
+    outputs_->writeScene();
     // Checkpoints of an earlier run into this directory do not belong to this
     // one (a restart keeps the one it started from until it writes its own).
     if (model_->rank0) removeCheckpoints(outputs_->directory(), restart_ ? restart_->checkpointDirectory() : "");

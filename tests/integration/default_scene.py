@@ -7,6 +7,8 @@ scene reported, the volume constraint holds (max |v_e/V_e - 1| <= 1e-10), and th
 body is in equilibrium: with no capstan, the supports' forces on the body sum to
 zero in every step (interface.md: "the sum of the supports' forces (on the body)
 equals the sum of the capstans' forces"), to 1e-8 of the largest support force.
+Each run also writes scene.xml, its scene as resolved; run again from it (into
+another directory) it gives the same summary figures to the last digit.
 """
 import os
 import sys
@@ -29,8 +31,15 @@ for name in ("default.xml", "squeeze.xml"):
     T.check(s["converged"] is True and s["failure"] is None, f"converged = {s['converged']}, failure = {s['failure']!r}")
     T.check(len(s["steps"]) == steps, f"{len(s['steps'])} steps reported ({steps})")
     T.check(not has_nan(s), "no NaN or infinity in summary.json")
-    for fname in ("summary.json", "history.csv", "fields.h5", "fields.xmf"):
+    for fname in ("summary.json", "history.csv", "fields.h5", "fields.xmf", "scene.xml"):
         T.check(os.path.isfile(os.path.join(out, fname)), f"{name}: {fname} written")
+    _, again, _ = T.run_scene(os.path.join(out, "scene.xml"), name[:-4] + "-again")
+
+    def figures(steps):  # every per-step figure but the wall time
+        return [{k: v for k, v in st.items() if "wall" not in k} for st in steps]
+
+    T.check(again is not None and figures(again["steps"]) == figures(s["steps"]) and again["final"] == s["final"],
+            f"{name}: run again from its scene.xml, the same steps and final figures")
     dv = s["final"]["max_abs_volume_change"]
     T.check(dv <= 1e-10, f"final.max_abs_volume_change = {dv:.2e} (<= 1e-10)")
     for st in s["steps"]:
