@@ -1,5 +1,8 @@
 #include "linear_solver_factories.hpp"
 
+#include <BelosBlockGmresSolMgr.hpp>
+#include <BelosPseudoBlockCGSolMgr.hpp>
+#include <BelosThyraAdapter.hpp>
 #include <Teuchos_AbstractFactoryStd.hpp>
 #include <Thyra_BelosLinearOpWithSolveFactory.hpp>
 #include <dlfcn.h>
@@ -143,6 +146,19 @@ ParameterList checkedBelosList(const ParameterList& scene, const std::string& ty
     }
     throw InputError("parameter 'Solver/Belos/" + name + "': Belos' " + type + " solver takes type " +
                      valid.getEntry(name).getAny(false).typeName() + ", got " + got.typeName());
+  }
+  // The values: the solver reads them as it is built (Num Blocks = 0 and an
+  // unknown orthogonalisation ended the run as a failed solve, exit 2).
+  if (checked.numParams() > 0) {
+    using MV = Thyra::MultiVectorBase<double>;
+    using OP = Thyra::LinearOpBase<double>;
+    auto list = Teuchos::rcp(new ParameterList(checked));
+    try {
+      if (type == "Block GMRES") Belos::BlockGmresSolMgr<double, MV, OP>().setParameters(list);
+      else Belos::PseudoBlockCGSolMgr<double, MV, OP>().setParameters(list);
+    } catch (const std::exception& e) {
+      throw InputError("parameter 'Solver/Belos': " + trilinosMessage(e.what()));
+    }
   }
   return checked;
 }

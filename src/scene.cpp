@@ -799,6 +799,9 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
     const auto& fs = m.fineSector;
     if (!std::isfinite(fs[0]) || !(fs[1] >= 0 && fs[1] < 360))
       v.fail("Mesh/Fine Sector", "the centre must be finite and the width in [0, 360) degrees");
+    // The centre modulo a turn: at 1e24 degrees the cells' angles rounded to one
+    // value (flat cells, NaN stresses).
+    m.fineSector[0] = std::remainder(fs[0], 360.0);
     if (fs[1] > 0 && !(fs[2] > 0 && fs[2] < 1))
       v.fail("Mesh/Fine Sector", "the fraction of cells in the sector must be in (0, 1)");
     // A straight-sided cell spanning half the ring or more turns inside out.

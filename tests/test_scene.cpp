@@ -637,6 +637,16 @@ TEST_F(SceneTest, AxisDirectionScale) {
   }
 }
 
+// The fine sector's centre is an angle: taken modulo a turn, so that a huge
+// one does not round the cells' angles to one value (NaN stresses).
+TEST_F(SceneTest, FineSectorCentreModuloATurn) {
+  const std::string slice = std::string(CAPSTAN_INPUTS_DIR) + "/pinch-roller-slice.xml";
+  EXPECT_EQ(loadScene(slice, {}, "").mesh.fineSector[0], -65.0);
+  EXPECT_EQ(loadScene(slice, {"Mesh/Fine Sector={295, 60, 0.6}"}, "").mesh.fineSector[0], -65.0);
+  const double c = loadScene(slice, {"Mesh/Fine Sector={1e24, 60, 0.6}"}, "").mesh.fineSector[0];
+  EXPECT_TRUE(c >= -180 && c <= 180) << c;
+}
+
 // A capstan that can never reach its faces is flagged, conservatively.
 TEST_F(SceneTest, UnreachableCapstanWarning) {
   const std::string g1 = std::string(CAPSTAN_INPUTS_DIR) + "/seed/g1.xml";

@@ -258,6 +258,8 @@ KRYLOV = ["--set", "Solver/Linear Solver=GMRES", "--set", "Solver/Preconditioner
 case("Solver/Belos: an unknown name", good, [good, "Solver/Belos/Bogus"], args=KRYLOV + ["--set", "Solver/Belos/Bogus=1"])
 case("Solver/Belos: a word for an int", good, [good, "Solver/Belos/Num Blocks"],
      args=KRYLOV + ["--set", "Solver/Belos/Num Blocks=many"])
+case("Solver/Belos: a value Belos refuses (Num Blocks = 0)", good, [good, "Solver/Belos", "Num Blocks"],
+     args=KRYLOV + ["--set", "Solver/Belos/Num Blocks=0"])
 case("Solver/Ifpack2: an unknown name", good, [good, "Solver/Ifpack2", "bogus"],
      args=KRYLOV + ["--set", "Solver/Ifpack2/bogus=0"])
 

@@ -10,8 +10,9 @@ seed/g1.xml (1575 dofs), GMRES + ILU(1), 2 steps:
 
 each converges, conforms to interface.md and agrees with the defaults on every
 step's support and capstan forces to 1e-8 (the same converged state), while its
-Krylov iteration count differs (the sublist took effect). Misspelt names in them
-are bad input: tests/integration/bad_input.py.
+Krylov iteration count differs (the sublist took effect). An int given where
+Ifpack2 takes a double (a damping factor of 1) is read as a double. Misspelt names
+and values Belos refuses are bad input: tests/integration/bad_input.py.
 """
 import os
 import sys
@@ -45,6 +46,13 @@ for label, scene, extra in (("defaults", base, []), ("Belos' Num Blocks = 4", be
     T.conforms(out, scene)
     runs[label] = s
     print(f"  {label}: Krylov iterations per step {[st['linear_iterations'] for st in s['steps']]}")
+
+# An int where Ifpack2 takes a double, as a user writes it on the command line.
+p, s, out = T.run_scene(base, "jacobi-damping", sets=["Solver/Linear Solver=GMRES", "Solver/Preconditioner=Jacobi",
+                                                      "Time/Steps=1", "Output/Write Fields=false",
+                                                      "Solver/Ifpack2/relaxation: damping factor=1"])
+T.check(s is not None and s["converged"] is True, "Jacobi with --set 'Solver/Ifpack2/relaxation: damping factor=1' "
+                                                  "(an int where Ifpack2 takes a double) runs and converges")
 
 if len(runs) == 3:
     a = runs["defaults"]
