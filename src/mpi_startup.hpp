@@ -18,7 +18,8 @@
 //   another starts, and the starting one's MPI_Init fails ("A call to mkdir
 //   was unable to create the desired directory"; 1 in 450 starts of three
 //   concurrent loops here, and twice in a day's ctest runs beside other jobs).
-//   So each singleton gets a base directory of its own, removed at its exit.
+//   So each singleton gets a base directory of its own, removed at its exit
+//   (a killed run leaves it, as Open MPI leaves its own session directories).
 #pragma once
 
 #include <sys/stat.h>
