@@ -39,11 +39,10 @@ std::array<double, 3> lineOfCentres(const MeshSpec& mesh, const CapstanSpec& cap
                                     const std::array<double, 3>& a, const std::array<double, 3>& b) {
   std::array<double, 3> n0{0, 0, 0};
   if (mesh.type == MeshSpec::Type::Box) {
-    for (const auto& face : capstan.contactFaces) {
-      const char* names[6] = {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
-      for (int k = 0; k < 6; ++k)
+    const auto names = mesh.faceNames();  // xmin xmax ymin ymax zmin zmax
+    for (const auto& face : capstan.contactFaces)
+      for (size_t k = 0; k < names.size(); ++k)
         if (face == names[k]) n0[k / 2] += k % 2 == 0 ? 1.0 : -1.0;
-    }
   }
   n0 = sub(n0, scale(b, dot(n0, b)));
   if (!(norm(n0) > 1e-12)) {  // an annulus, or box faces whose normals cancel: towards the roller's axis

@@ -476,10 +476,10 @@ void applySet(ParameterList& scene, const ParameterList& valid, const std::strin
   if (!typed && passedThrough) {
     int i;
     double d;
-    const std::string lower = trimmed(value);
+    const std::string word = trimmed(value);
     if (readInt(value, i)) list->set(name, i);
     else if (readDouble(value, d)) list->set(name, d);
-    else if (lower == "true" || lower == "false") list->set(name, lower == "true");
+    else if (word == "true" || word == "false") list->set(name, word == "true");
     else list->set(name, value);
     return;
   }

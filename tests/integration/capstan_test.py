@@ -79,6 +79,17 @@ class Test:
     def path(self, *parts):
         return os.path.join(self.dir, *parts)
 
+    def scene_with(self, source, name, xml, anchor='<ParameterList name="Output">'):
+        """A copy of scene SOURCE in the scratch directory (NAME) with XML inserted
+        before ANCHOR (by default its Output list): e.g. a Solver list of one's own."""
+        with open(source) as fh:
+            text = fh.read()
+        self.check(anchor in text, f"{os.path.basename(source)} has {anchor!r} to insert before")
+        path = self.path(name)
+        with open(path, "w") as fh:
+            fh.write(text.replace(anchor, xml + anchor, 1))
+        return path
+
     # -- running the driver --------------------------------------------------
     def command(self, args, ranks=1):
         cmd = [self.capstan] + list(args)
@@ -125,6 +136,17 @@ class Test:
             except ValueError as e:
                 self.check(False, f"{sp}: not valid JSON: {e}")
         return p, summary, outdir
+
+    def converged_run(self, scene, out, label, sets=(), ranks=1, env=None):
+        """run_scene, checked to converge and to conform to interface.md; the
+        summary, or None."""
+        p, s, outdir = self.run_scene(scene, out, sets=sets, ranks=ranks, env=env)
+        if s is None:
+            self.check(False, f"{label}: no summary.json ({p.stderr.strip()[:200]})")
+            return None
+        self.check(s["converged"] is True, f"{label}: converged = {s['converged']} ({s['failure']!r})")
+        self.conforms(outdir, scene)
+        return s
 
     @staticmethod
     def log_events(outdir, event=None):

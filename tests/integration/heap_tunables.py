@@ -48,14 +48,8 @@ print(f"  kernel transparent huge pages: {mode}")
 
 def run(label, tunables, ranks=1, extra=()):
     """One run with GLIBC_TUNABLES set as given; checks that it converged and conforms."""
-    p, s, out = T.run_scene(scene, label.replace(" ", "-").replace(",", "").replace("'", ""),
-                            sets=sets + list(extra), ranks=ranks, env={"GLIBC_TUNABLES": tunables})
-    if s is None:
-        T.check(False, f"{label}: no summary.json")
-        return None
-    T.check(s["converged"] is True, f"{label}: converged = {s['converged']} ({s['failure']!r})")
-    T.conforms(out, scene)
-    return s
+    return T.converged_run(scene, label.replace(" ", "-").replace(",", "").replace("'", ""), label,
+                           sets=sets + list(extra), ranks=ranks, env={"GLIBC_TUNABLES": tunables})
 
 
 def same_answers(label, ref, s):
