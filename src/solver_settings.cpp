@@ -89,7 +89,7 @@ void SolverSettings::declare(ParameterList& sol) {
   sol.sublist("Stratimikos", false, "Passed to Stratimikos unchanged, over capstan's defaults");
   sol.sublist("Belos", false,
               "Passed to the Belos solver (Block GMRES, or Pseudo Block CG with Linear Solver = CG) unchanged, "
-              "over capstan's defaults; its names are checked against the solver's (unused with Direct)");
+              "over capstan's defaults; its names, types and values are checked against the solver's (unused with Direct)");
   sol.sublist("Ifpack2", false,
               "Passed to the Ifpack2 preconditioner (Preconditioner = ILU or Jacobi) unchanged, over capstan's "
               "defaults (unused with the other preconditioners)");
