@@ -69,6 +69,9 @@ KOKKOS_INLINE_FUNCTION void regularisedLaw(FrictionLaw law, double s, double v, 
 }
 
 // What one friction point reports.
+// A point's hold (frictionFaceResidualTangent's held): free, or Coulomb's branch fixed.
+constexpr int kHeldInSlip = 1, kHeldInStick = 2;
+
 struct FrictionPoint {
   double traction[3] = {0, 0, 0};  // friction traction on the body (per reference area)
   double normal = 0;               // t_n
@@ -89,14 +92,15 @@ struct FrictionPoint {
 // Kn (if not null, with K): the tangent with respect to xn, dR/dxn (12 x 12),
 // which steady rolling needs: there xn is the upstream nodes' position
 // (src/effects/steady_friction.cpp), an unknown like x.
-// slipHeld (if not null): per point, nonzero to take Coulomb's slip branch even
-// inside the cone (a point the multiplier loop found toggling; FrictionEffect::notePass).
+// held (if not null): per point, kHeldInSlip to take Coulomb's slip branch even
+// inside the cone (a point the multiplier loop found toggling), kHeldInStick its
+// stick branch even outside it (the loop's states frozen; FrictionEffect::notePass).
 // Returns false (R, K untouched) if no point of the face is in contact.
 KOKKOS_INLINE_FUNCTION bool frictionFaceResidualTangent(
     const double X[4][3], const double x[4][3], const double xn[4][3], const Cylinder& cyl,
     double eps, double kappa, const double* lambda, FaceRule rule, const FrictionParameters& fp,
     const double* history, double R[12], double* K, FrictionPoint pts[kMaxFacePoints],
-    double* Kn = nullptr, const int* slipHeld = nullptr) {
+    double* Kn = nullptr, const int* held = nullptr) {
   const int nq = facePointCount(rule);
   bool touching = false;
   for (int q = 0; q < nq && !touching; ++q) {
@@ -204,7 +208,8 @@ KOKKOS_INLINE_FUNCTION bool frictionFaceResidualTangent(
             Tn[i][j] = Trn[i][j] / m - tr[i] / (m * m) * dm * dSn[j];
           }
         }
-      } else if ((mag <= fp.mu * tn && !(slipHeld && slipHeld[q] && mag > 0)) || fp.stickPredictor) {  // stick
+      } else if ((mag <= fp.mu * tn && !(held && held[q] == kHeldInSlip && mag > 0)) ||
+                 (held && held[q] == kHeldInStick) || fp.stickPredictor) {  // stick
         p.state = 1;
         for (int i = 0; i < 3; ++i) {
           t[i] = tr[i];

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 namespace capstan {
 
@@ -72,6 +73,16 @@ constexpr int kHoldAfterPasses = 3;
 // (3x100x8: 61 Newton iterations against 54, the speed ratio 1.4e-4 away);
 // after 6, every scene that converged converges as before, to the bit.
 constexpr int kHoldAnyAfterPasses = 6;
+// And once it has not for this many, every point's state is frozen (FrictionEffect::
+// notePass: in stick until its traction leaves the cone, then in slip), and the
+// stall test counts afresh from there; the loop then has kFrozenPasses passes to
+// converge. States that move one way only settle: the uniform radial cells above
+// converge so whatever the BLAS kernels' round-off (54 and 64 Newton iterations
+// with OpenBLAS' AVX2 and SSE kernels; with the SSE ones they had not in 11 min).
+// A loop stalled otherwise (a 300x too soft stick) creeps on frozen: it fails 10
+// passes later and converges on its retry (78 Newton iterations against 73).
+constexpr int kFreezeAfterPasses = 8;
+constexpr int kFrozenPasses = 10;
 
 json::Object eventOf(const char* name) { return json::Object().add("event", json::string(name)); }
 
@@ -95,6 +106,7 @@ bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string
   for (auto* fr : m_.assembly->frictions())  // a new solve: every point free (null: a capstan without friction)
     if (fr) fr->releaseHeldSlips();
   heldSlips_ = 0;
+  frozen_ = false;
   std::optional<StepStart> beforeStep;
   Vector f(m_.u->getMap());
   for (int it = 1; it <= maxOuter; ++it) {
@@ -155,25 +167,43 @@ bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string
 }
 
 bool AugmentationLoop::holdCyclingSlips(int it) {
-  long local = 0, all = 0;
   // Only once the loop has stopped gaining: early passes move the stick zone's
   // edge back and forth on their way (the 3D drive at 3x160x8 converges so;
   // holding its edge node there moved the speed ratio by 7e-5).
   const bool mayHold = it - bestPass_ >= kHoldAfterPasses;
+  const bool freezeNow = !frozen_ && it - bestPass_ >= kFreezeAfterPasses;
+  int local = 0, any = 0;
   for (auto* fr : m_.assembly->frictions())
-    if (fr) local += fr->notePass(mayHold, it - bestPass_ >= kHoldAnyAfterPasses);
-  Teuchos::reduceAll(*m_.comm, Teuchos::REDUCE_SUM, local, Teuchos::outArg(all));
-  if (all == heldSlips_) return false;
+    if (fr && fr->notePass(mayHold, it - bestPass_ >= kHoldAnyAfterPasses, frozen_ || freezeNow)) local = 1;
+  Teuchos::reduceAll(*m_.comm, Teuchos::REDUCE_MAX, local, Teuchos::outArg(any));
+  if (freezeNow) {
+    frozen_ = true, frozenAt_ = it;
+    bestWorst_ = std::numeric_limits<double>::infinity();  // the stall test from this pass
+    if (log_.on("newton"))
+      log_.event("newton", format("pass %d: stick and slip frozen (stick until the cone, then slip)", it),
+                 eventOf("states_frozen"));
+  }
+  if (!any) return false;
+  long mine = 0, all = 0;
+  for (auto* fr : m_.assembly->frictions())
+    if (fr) mine += fr->heldPoints();
+  Teuchos::reduceAll(*m_.comm, Teuchos::REDUCE_SUM, mine, Teuchos::outArg(all));
   heldSlips_ = all;
   if (log_.on("newton"))
-    log_.event("newton", format("pass %d: %ld points cycling between stick and slip held in slip", it, all),
+    log_.event("newton", format("pass %d: %ld points held (cycling between stick and slip, or frozen)", it, all),
                eventOf("held_slips").add("points", json::number(double(all))));
   return true;
 }
 
 bool AugmentationLoop::stalled(int it, const Constraints& c, std::string& failure) {
   if (it == 1 || c.worst < bestWorst_) bestWorst_ = c.worst, bestPass_ = it;
-  if (!m_.pressureStep || it - bestPass_ < kStallPasses) return false;
+  if (!m_.pressureStep) return false;
+  if (frozen_ && it - frozenAt_ >= kFrozenPasses) {
+    failure = format("%s: %s at %.3g x its tolerance %d passes after stick and slip were frozen", kStalledLoop,
+                     c.worstName.c_str(), c.worst, kFrozenPasses);
+    return true;
+  }
+  if (it - bestPass_ < kStallPasses) return false;
   failure = format("%s: %s at %.3g x its tolerance, not below pass %d's %.3g x in %d passes", kStalledLoop,
                    c.worstName.c_str(), c.worst, bestPass_, bestWorst_, kStallPasses);
   return true;

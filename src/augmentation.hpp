@@ -91,9 +91,12 @@ class AugmentationLoop {
   // below its best for kStallPasses passes (failure set).
   bool stalled(int it, const Constraints& c, std::string& failure);
   // After a pass's Newton solve: friction points cycling between stick and
-  // slip held in slip (FrictionEffect::notePass); true where more are held now.
+  // slip held in slip, at last every state frozen (FrictionEffect::notePass);
+  // true where a hold changed.
   bool holdCyclingSlips(int it);
   long heldSlips_ = 0;
+  bool frozen_ = false;  // the friction points' states frozen (holdCyclingSlips), at pass frozenAt_
+  int frozenAt_ = 0;
   double bestWorst_ = 0;
   int bestPass_ = 0;
   // The pass's Newton solve on the positions (none for a step alone), with

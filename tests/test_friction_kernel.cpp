@@ -43,7 +43,7 @@ struct Case {
   double history;      // Coulomb: magnitude of last step's traction
   int expectState;     // every point: 1 stick, 2 slip (0: do not check)
   double smoothing = 0;  // Coulomb: the smoothed stick/slip corner's width
-  bool held = false;     // Coulomb: every point held in slip (FrictionEffect::notePass)
+  int held = 0;          // Coulomb: every point's hold, kHeldInSlip or kHeldInStick (FrictionEffect::notePass)
 };
 
 std::vector<double> residual(const double X[4][3], const double x[4][3], const double xn[4][3],
@@ -72,7 +72,7 @@ TEST_P(FrictionTangent, MatchesCentralDifferences) {
   fp.smoothing = k.smoothing;
   double lambda[kMaxFacePoints] = {}, h[3 * kMaxFacePoints];
   int heldAll[kMaxFacePoints];
-  std::fill(heldAll, heldAll + kMaxFacePoints, 1);
+  std::fill(heldAll, heldAll + kMaxFacePoints, k.held);
   const int* held = k.held ? heldAll : nullptr;
   for (int q = 0; q < kMaxFacePoints; ++q) {
     h[3 * q] = k.history * (1 + 0.1 * q);
@@ -96,15 +96,18 @@ TEST_P(FrictionTangent, MatchesCentralDifferences) {
                                     pts[q].traction[1] * pts[q].traction[1] +
                                     pts[q].traction[2] * pts[q].traction[2]);
       EXPECT_GT(pts[q].normal, 0) << k.name;
-      EXPECT_LE(tmag, k.mu * pts[q].normal * (1 + 1e-12)) << k.name << ": |t_f| > mu t_n";
+      if (k.held == kHeldInStick)  // the stick branch outside the cone (this case's trial traction)
+        EXPECT_GT(tmag, k.mu * pts[q].normal) << k.name << ": held in stick, not outside the cone";
+      else
+        EXPECT_LE(tmag, k.mu * pts[q].normal * (1 + 1e-12)) << k.name << ": |t_f| > mu t_n";
       if (k.expectState) {
         EXPECT_EQ(pts[q].state, k.expectState) << k.name << " point " << q;
       }
-      if (k.held) {
+      if (k.held == kHeldInSlip) {
         EXPECT_NEAR(tmag, k.mu * pts[q].normal, 1e-12 * k.mu * pts[q].normal) << k.name << ": at the cone";
       }
       // Coulomb: central differences must not straddle the stick/slip switch.
-      if (k.law == FrictionLaw::Coulomb && pts[q].state == 1)
+      if (k.law == FrictionLaw::Coulomb && pts[q].state == 1 && k.held != kHeldInStick)
         nearSwitch = nearSwitch || tmag > k.mu * pts[q].normal * (1 - 1e-4);
     }
     if (nearSwitch) continue;
@@ -156,7 +159,10 @@ INSTANTIATE_TEST_SUITE_P(
         Case{"coulomb, smoothed corner", FrictionLaw::Coulomb, 0.3, 0, 1e-2, {0, 0, 0}, 0.01, {0, 0, 1}, 0.05, 0, 0.3},
         // The stick case's points held in slip: the slip branch inside the cone.
         Case{"coulomb stick held in slip", FrictionLaw::Coulomb, 5.0, 0, 0.1, {0, 0, 0}, 0.01, {0, 0, 1}, 0.05, 2, 0,
-             true}));
+             kHeldInSlip},
+        // The slip case's points held in stick (the loop's states frozen): the stick branch outside it.
+        Case{"coulomb slip held in stick", FrictionLaw::Coulomb, 0.1, 0, 1e-3, {0, 0, 0}, 0.05, {0, 0, 1}, 0.05, 1, 0,
+             kHeldInStick}));
 
 // psi = phi(s)/s and chi = psi'(s)/s against finite differences of phi(s)/s,
 // across the series/closed-form switch, and finite at s = 0.

@@ -31,7 +31,7 @@ FrictionEffect::FrictionEffect(const std::string& name, const Mesh& mesh,
   history_ = Kokkos::View<double*>("friction history", nf * kHistoryPerFace);
   tangentialMultipliers_ = Kokkos::View<double*>("friction lambda_T", nf * kernels::kMaxFacePoints * 3);
   points_ = decltype(points_)("friction points", nf, kernels::kMaxFacePoints);
-  slipHeld_ = Kokkos::View<int*>("friction slip held", nf * kernels::kMaxFacePoints);
+  heldBranch_ = Kokkos::View<int*>("friction held branch", nf * kernels::kMaxFacePoints);
   local_.dofs = dofsOf(nodes_);
   local_.R = Matrix("friction R", nf, 12);
   local_.stiff = true;
@@ -82,7 +82,7 @@ void FrictionEffect::launch(const NodalVectors& x, const NodalVectors&, bool tan
   auto lambda = contact_.normalMultipliers();
   auto h = history_;
   auto lambdaT = tangentialMultipliers_;
-  auto held = slipHeld_;
+  auto held = heldBranch_;
   const bool useMultipliers = augmented();
   auto pts = points_;
   const kernels::Cylinder cyl = contact_.cylinder();
@@ -148,13 +148,13 @@ void FrictionEffect::multiplierMap(const Kokkos::View<double*>& next) const {
       });
 }
 
-long FrictionEffect::notePass(bool mayHold, bool lastResort) {
-  if (!stepsForItself()) return 0;
+bool FrictionEffect::notePass(bool mayHold, bool lastResort, bool freeze) {
+  if (!stepsForItself()) return false;
   auto pts = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), points_);
   const size_t nf = pts.extent(0);
   const int nq = kernels::facePointCount(contact_.rule());
   cycles_.resize(nf * kernels::kMaxFacePoints);
-  std::vector<size_t> newlyHeld;
+  std::vector<std::pair<size_t, int>> changed;  // (point, its new hold)
   for (size_t f = 0; f < nf; ++f)
     for (int q = 0; q < nq; ++q) {
       const size_t k = f * kernels::kMaxFacePoints + q;
@@ -163,25 +163,36 @@ long FrictionEffect::notePass(bool mayHold, bool lastResort) {
       // A, B, A: one return; A, B, A, B, A: three, a cycle. Changes: between
       // stick and slip, while in contact.
       if (now != 0 && c.last > 0 && now != c.last) ++c.changes;
-      if (now != 0 && now != c.last && now == c.beforeLast && ++c.returns >= 3 && mayHold && !c.held)
-        c.held = true, newlyHeld.push_back(k);
-      else if (lastResort && now != 0 && c.changes >= 4 && !c.held)
-        c.held = true, newlyHeld.push_back(k);
+      if (now != 0 && now != c.last && now == c.beforeLast && ++c.returns >= 3 && mayHold && !c.hold)
+        changed.emplace_back(k, kernels::kHeldInSlip);
+      else if (lastResort && now != 0 && c.changes >= 4 && !c.hold)
+        changed.emplace_back(k, kernels::kHeldInSlip);
+      else if (freeze && now != 0 && !c.hold)
+        changed.emplace_back(k, now == 1 ? kernels::kHeldInStick : kernels::kHeldInSlip);
+      else if (c.hold == kernels::kHeldInStick) {
+        // Frozen in stick: into slip (for good) once its traction leaves the cone.
+        const double t = std::sqrt(pts(f, q, kTraction) * pts(f, q, kTraction) +
+                                   pts(f, q, kTraction + 1) * pts(f, q, kTraction + 1) +
+                                   pts(f, q, kTraction + 2) * pts(f, q, kTraction + 2));
+        if (t > parameters_.mu * pts(f, q, kNormal) * (1 + 1e-9)) changed.emplace_back(k, kernels::kHeldInSlip);
+      }
       c.beforeLast = c.last, c.last = now;
     }
-  if (newlyHeld.empty()) return held_;
-  auto held = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), slipHeld_);
-  for (size_t k : newlyHeld) held(k) = 1;
-  Kokkos::deep_copy(slipHeld_, held);
-  held_ += long(newlyHeld.size());
-  return held_;
+  if (changed.empty()) return false;
+  auto held = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), heldBranch_);
+  for (const auto& [k, hold] : changed) {
+    if (!cycles_[k].hold) ++heldPoints_;
+    held(k) = cycles_[k].hold = hold;
+  }
+  Kokkos::deep_copy(heldBranch_, held);
+  return true;
 }
 
 void FrictionEffect::releaseHeldSlips() {
   cycles_.clear();
-  if (held_ == 0) return;
-  Kokkos::deep_copy(slipHeld_, 0);
-  held_ = 0;
+  if (heldPoints_ == 0) return;
+  Kokkos::deep_copy(heldBranch_, 0);
+  heldPoints_ = 0;
 }
 
 void FrictionEffect::stickRows(ConstraintRows& rows, int width, const StickRowFill& fill, std::vector<double>& grad,

@@ -73,8 +73,12 @@ class FrictionEffect : public Effect {
   // reach) is held in slip, at the cone, for the rest of the solve, where the
   // loop has stopped making progress (mayHold); with lastResort (it has not
   // for longer), any point whose state has changed four times or more in the
-  // solve too. Released at the next solve. Returns the points held so far.
-  long notePass(bool mayHold, bool lastResort);
+  // solve too. With freeze (longer still), every other point in contact is
+  // held in the state it has, and a point held in stick goes into slip (for
+  // good) once its traction leaves the cone: the states can only move one way,
+  // so they settle. Released at the next solve. True where a hold changed.
+  bool notePass(bool mayHold, bool lastResort, bool freeze);
+  long heldPoints() const { return heldPoints_; }
   void releaseHeldSlips();
   double constraintViolation() const override;
   double constraintTolerance() const override { return contact_.constraintTolerance(); }
@@ -116,16 +120,16 @@ class FrictionEffect : public Effect {
   // [face][12 + 3q + i]: Coulomb's traction at point q from that state.
   Kokkos::View<double*> history_;
   Kokkos::View<double*> tangentialMultipliers_;  // [(face * kMaxFacePoints + q) * 3 + i]
-  Kokkos::View<int*> slipHeld_;                  // [face * kMaxFacePoints + q]: notePass
+  Kokkos::View<int*> heldBranch_;                // [face * kMaxFacePoints + q]: notePass's holds
   struct PointCycle {     // one point's stick/slip states over the passes (notePass)
     int beforeLast = -1;  // two passes ago
     int last = -1;        // the last pass
     int returns = 0;      // passes back to the state of two passes before
     int changes = 0;      // passes whose state (in contact) differed from the last
-    bool held = false;
+    int hold = 0;         // 0 free, kernels::kHeldInSlip or kHeldInStick
   };
   std::vector<PointCycle> cycles_;  // [face * kMaxFacePoints + q]
-  long held_ = 0;
+  long heldPoints_ = 0;
   static constexpr int kHistoryPerFace = 12 + 3 * kernels::kMaxFacePoints;
   // Coulomb's sticking points, two rows each (constraintRows): the value,
   // multiplier, force, Schur diagonal and direction of each row into rows;

@@ -168,7 +168,7 @@ void SteadyFrictionEffect::launch(const NodalVectors& x, const NodalVectors&, bo
   auto active = local_.active;
   auto lambda = contact_.normalMultipliers();
   auto lambdaT = tangentialMultipliers_;
-  auto held = slipHeld_;
+  auto held = heldBranch_;
   auto h = history_;
   const bool useMultipliers = augmented();
   auto pts = points_;
