@@ -134,6 +134,7 @@ Restart::Restart(const Scene& scene, const Comm& comm, const std::string& dir)
   const bool rank0 = comm.getRank() == 0;
   // Rank 0 picks the checkpoint, so every rank reads the same one.
   std::string found, error;
+  std::string rank0Bytes;  // rank 0's file, read once: for the rank count here, for the values below
   int files = 0;
   if (rank0) {
     const fs::path latest = checkpoint::latest(fs::path(dir) / "checkpoint");
@@ -147,7 +148,8 @@ Restart::Restart(const Scene& scene, const Comm& comm, const std::string& dir)
       // is a damaged checkpoint, not one of fewer ranks.
       try {
         std::ifstream in(latest / checkpoint::rankFile(0), std::ios::binary);
-        checkpoint::Reader rd(std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()));
+        if (in) rank0Bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+        checkpoint::Reader rd(rank0Bytes);
         if (rd.getString() == checkpoint::kMagic) {
           const int written = rd.get<int>();
           if (written != files)
@@ -167,9 +169,12 @@ Restart::Restart(const Scene& scene, const Comm& comm, const std::string& dir)
   checkpointDir_ = found;
   file_ = checkpointDir_ / checkpoint::rankFile(comm.getRank());
   try {
-    std::ifstream in(file_, std::ios::binary);
-    if (!in) throw std::runtime_error("cannot read it");
-    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::string bytes = std::move(rank0Bytes);
+    if (bytes.empty()) {
+      std::ifstream in(file_, std::ios::binary);
+      if (!in) throw std::runtime_error("cannot read it");
+      bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
     in_ = std::make_unique<checkpoint::Reader>(std::move(bytes));
     auto& rd = *in_;
     if (rd.getString() != checkpoint::kMagic) throw std::runtime_error("not a capstan checkpoint");
