@@ -75,14 +75,19 @@ constexpr int kHoldAfterPasses = 3;
 constexpr int kHoldAnyAfterPasses = 6;
 // And once it has not for this many, every point's state is frozen (FrictionEffect::
 // notePass: in stick until its traction leaves the cone, then in slip), and the
-// stall test counts afresh from there; the loop then has kFrozenPasses passes to
-// converge. States that move one way only settle: the uniform radial cells above
-// converge so whatever the BLAS kernels' round-off (54 and 64 Newton iterations
-// with OpenBLAS' AVX2 and SSE kernels; with the SSE ones they had not in 11 min).
-// A loop stalled otherwise (a 300x too soft stick) creeps on frozen: it fails 10
-// passes later and converges on its retry (78 Newton iterations against 73).
+// stall test counts afresh from there. States that move one way only settle: the
+// uniform radial cells above converge so whatever the BLAS kernels' round-off
+// (54 and 64 Newton iterations with OpenBLAS' AVX2 and SSE kernels; with the SSE
+// ones they had not in 11 min).
 constexpr int kFreezeAfterPasses = 8;
-constexpr int kFrozenPasses = 10;
+// Frozen, the loop goes on while its worst constraint falls at least
+// kFrozenGain-fold over each kFrozenWindow passes, for at most kFrozenPasses
+// passes. Finer nips take more than 10 frozen passes (3x180x8: 9.8e6 -> 3.0 x
+// its tolerance in 10, 10x a pass early and 2x at the end); a loop stalled
+// otherwise (a 300x too soft stick) creeps, 1.4x in its second five.
+constexpr int kFrozenWindow = 5;
+constexpr double kFrozenGain = 2;
+constexpr int kFrozenPasses = 30;
 
 json::Object eventOf(const char* name) { return json::Object().add("event", json::string(name)); }
 
@@ -177,7 +182,7 @@ bool AugmentationLoop::holdCyclingSlips(int it) {
     if (fr && fr->notePass(mayHold, it - bestPass_ >= kHoldAnyAfterPasses, frozen_ || freezeNow)) local = 1;
   Teuchos::reduceAll(*m_.comm, Teuchos::REDUCE_MAX, local, Teuchos::outArg(any));
   if (freezeNow) {
-    frozen_ = true, frozenAt_ = it;
+    frozen_ = true, frozenAt_ = it, frozenWorst_.clear();
     bestWorst_ = std::numeric_limits<double>::infinity();  // the stall test from this pass
     if (log_.on("newton"))
       log_.event("newton", format("pass %d: stick and slip frozen (stick until the cone, then slip)", it),
@@ -198,10 +203,16 @@ bool AugmentationLoop::holdCyclingSlips(int it) {
 bool AugmentationLoop::stalled(int it, const Constraints& c, std::string& failure) {
   if (it == 1 || c.worst < bestWorst_) bestWorst_ = c.worst, bestPass_ = it;
   if (!m_.pressureStep) return false;
-  if (frozen_ && it - frozenAt_ >= kFrozenPasses) {
-    failure = format("%s: %s at %.3g x its tolerance %d passes after stick and slip were frozen", kStalledLoop,
-                     c.worstName.c_str(), c.worst, kFrozenPasses);
-    return true;
+  if (frozen_) {
+    frozenWorst_.push_back(c.worst);  // one per pass checked since the freeze
+    const int k = it - frozenAt_, m = int(frozenWorst_.size()) - 1;
+    const bool slow = m >= kFrozenWindow && c.worst > frozenWorst_[m - kFrozenWindow] / kFrozenGain;
+    if (slow || k >= kFrozenPasses) {
+      failure = format("%s: %s at %.3g x its tolerance %d passes after stick and slip were frozen%s", kStalledLoop,
+                       c.worstName.c_str(), c.worst, k, slow ? format(", not %gx below it %d passes before", kFrozenGain,
+                                                                       kFrozenWindow).c_str() : "");
+      return true;
+    }
   }
   if (it - bestPass_ < kStallPasses) return false;
   failure = format("%s: %s at %.3g x its tolerance, not below pass %d's %.3g x in %d passes", kStalledLoop,

@@ -97,6 +97,7 @@ class AugmentationLoop {
   long heldSlips_ = 0;
   bool frozen_ = false;  // the friction points' states frozen (holdCyclingSlips), at pass frozenAt_
   int frozenAt_ = 0;
+  std::vector<double> frozenWorst_;  // the worst constraint of each pass checked since (stalled)
   double bestWorst_ = 0;
   int bestPass_ = 0;
   // The pass's Newton solve on the positions (none for a step alone), with

@@ -22,9 +22,10 @@ first order).
     speed ratios within 2e-5 too;
   * the steady 3D drive with a very soft stick (Tangential Penalty = 1, 300x the automatic
     value): the augmentation loop does not converge with it (it stalls, freezes stick and
-    slip after 8 passes without gain, creeps, and ends 10 passes later: AugmentationLoop),
+    slip after 8 passes without gain, creeps, and ends 10 frozen passes later, where it
+    has gained less than 2x over 5: AugmentationLoop),
     the retry with a stick 10x the automatic one converges and the scene's stick holds from
-    there (78 Newton iterations); against the shipped scene;
+    there (77 Newton iterations); against the shipped scene;
   * the steady 3D drive under Tanh with Regularization = 1e-4 (a slip speed scale 2e-6 of
     the capstan's surface speed): its start from rest goes through its own law at wider
     scales (SteadyRolling::startThroughWideLaws; 453 Newton iterations before, through
