@@ -110,7 +110,6 @@ bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string
   PassPolicy passes(m_.monolithic);
   for (auto* fr : m_.assembly->frictions())  // a new solve: every point free (null: a capstan without friction)
     if (fr) fr->releaseHeldSlips();
-  heldSlips_ = 0;
   frozen_ = false;
   std::optional<StepStart> beforeStep;
   Vector f(m_.u->getMap());
@@ -193,7 +192,6 @@ bool AugmentationLoop::holdCyclingSlips(int it) {
   for (auto* fr : m_.assembly->frictions())
     if (fr) mine += fr->heldPoints();
   Teuchos::reduceAll(*m_.comm, Teuchos::REDUCE_SUM, mine, Teuchos::outArg(all));
-  heldSlips_ = all;
   if (log_.on("newton"))
     log_.event("newton", format("pass %d: %ld points held (cycling between stick and slip, or frozen)", it, all),
                eventOf("held_slips").add("points", json::number(double(all))));

@@ -94,7 +94,6 @@ class AugmentationLoop {
   // slip held in slip, at last every state frozen (FrictionEffect::notePass);
   // true where a hold changed.
   bool holdCyclingSlips(int it);
-  long heldSlips_ = 0;
   bool frozen_ = false;  // the friction points' states frozen (holdCyclingSlips), at pass frozenAt_
   int frozenAt_ = 0;
   std::vector<double> frozenWorst_;  // the worst constraint of each pass checked since (stalled)
