@@ -48,15 +48,19 @@ def turned_sector(nt, turn, sector=SECTOR):
     return centre, "Mesh/Fine Sector={%.10g, %g, %g}" % (centre, sector[1], sector[2])
 
 
-def run_scene(capstan, scene, out, sets=()):
+def run_scene(capstan, scene, out, sets=(), ranks=1, extra=(), env=None, timeout=None):
     """One quiet `capstan run` of inputs/SCENE with no field output, timed:
-    (exit status, wall seconds, summary.json or None)."""
+    (exit status, wall seconds, summary.json or None). EXTRA: more driver options
+    (e.g. ["--log", "newton"]); ENV: variables added to the run's environment;
+    TIMEOUT: seconds, past which subprocess.TimeoutExpired is raised."""
     cmd = [capstan, "run", os.path.join(ROOT, "inputs", scene), "--output", out, "--quiet",
-           "--set", "Output/Write Fields=false"]
+           "--set", "Output/Write Fields=false"] + list(extra)
     for s in sets:
         cmd += ["--set", s]
+    if ranks > 1:
+        cmd = ["mpiexec", "--oversubscribe", "-n", str(ranks)] + cmd
     t0 = time.perf_counter()
-    p = subprocess.run(cmd, capture_output=True, text=True)
+    p = subprocess.run(cmd, capture_output=True, text=True, env=dict(ENV, **(env or {})), timeout=timeout)
     wall = time.perf_counter() - t0
     path = os.path.join(out, "summary.json")
     if not os.path.isfile(path):

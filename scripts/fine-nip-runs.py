@@ -14,7 +14,7 @@ import subprocess
 import sys
 import tempfile
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+from capstan_runs import ROOT, run_scene
 
 
 def main():
@@ -26,39 +26,31 @@ def main():
     ap.add_argument("--capstan", default=os.path.join(ROOT, "build", "capstan"))
     ap.add_argument("--timeout", type=float, default=1800, help="seconds a run may take")
     args = ap.parse_args()
-    sets = ["Mesh/Fine Sector={-90, 20, 0.6}", "Output/Write Fields=false"]
+    sets = ["Mesh/Fine Sector={-90, 20, 0.6}"]
     sets += ["Mesh/Cells={3, 160, 8}", "Mesh/Outer Cell Ratio=1"] if args.uniform else ["Mesh/Cells={3, 120, 8}"]
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
-    if args.coretype:
-        env["OPENBLAS_CORETYPE"] = args.coretype
-    pre = [] if args.ranks == 1 else ["mpiexec", "--oversubscribe", "-n", str(args.ranks)]
+    env = {"OPENBLAS_CORETYPE": args.coretype} if args.coretype else None
     print(f"{'run':>3} {'exit':>4} {'newton':>6} {'cuts':>4} {'held':>4} {'speed ratio':>11} {'seconds':>8}")
     with tempfile.TemporaryDirectory(prefix="capstan-fine-nip-") as scratch:
         for k in range(args.runs):
             out = os.path.join(scratch, f"run{k}")
-            cmd = pre + [args.capstan, "run", os.path.join(ROOT, "inputs", "pinch-roller-steady.xml"), "--output",
-                         out, "--log", "newton", "--quiet"]
-            for s in sets:
-                cmd += ["--set", s]
             try:
-                rc = subprocess.run(cmd, env=env, capture_output=True, timeout=args.timeout).returncode
+                rc, _, s = run_scene(args.capstan, "pinch-roller-steady.xml", out, sets, ranks=args.ranks,
+                                     extra=["--log", "newton"], env=env, timeout=args.timeout)
             except subprocess.TimeoutExpired:
                 print(f"{k:>3} not ended within {args.timeout:.0f} s")
                 continue
-            try:
-                with open(os.path.join(out, "summary.json")) as fh:
-                    s = json.load(fh)
-                st = s["steps"][-1]
-                held = 0
-                with open(os.path.join(out, "log.jsonl")) as fh:
-                    for line in fh:
-                        e = json.loads(line)
-                        if e.get("event") == "held_slips":
-                            held = max(held, int(e["points"]))
-                print(f"{k:>3} {rc:>4} {st['newton_iterations']:>6} {st['cutbacks']:>4} {held:>4} "
-                      f"{st['supports']['core']['speed_ratio']:>11.8f} {s['timing']['total']:>8.1f}", flush=True)
-            except (OSError, ValueError, KeyError, IndexError) as e:
-                print(f"{k:>3} {rc:>4} no steady step in its summary ({e})", flush=True)
+            if s is None or not s["steps"]:
+                print(f"{k:>3} {rc:>4} no steady step in its summary", flush=True)
+                continue
+            st = s["steps"][-1]
+            held = 0
+            with open(os.path.join(out, "log.jsonl")) as fh:
+                for line in fh:
+                    e = json.loads(line)
+                    if e.get("event") == "held_slips":
+                        held = max(held, int(e["points"]))
+            print(f"{k:>3} {rc:>4} {st['newton_iterations']:>6} {st['cutbacks']:>4} {held:>4} "
+                  f"{st['supports']['core']['speed_ratio']:>11.8f} {s['timing']['total']:>8.1f}", flush=True)
     return 0
 
 
