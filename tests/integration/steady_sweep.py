@@ -6,6 +6,10 @@ ramped to 18 N mm (90% of mu F R) over 10 steps, as scripts/steady-bench.py runs
   * 10 steps, no cut; every step after the first (the steady state from rest) at most 20
     Newton iterations;
   * the speed ratio falls with each torque step (more brake, more creep);
+  * from rest, the starting guesses (the frictionless footprint and the Tanh stages, one
+    pass each) are solved only to 2e-6 c L^2 (src/augmentation.cpp, kGuessTolerance):
+    at most 16 Newton residuals together (12 today; 21 with each solved to the step's
+    tolerance);
   * the saddle-point step was shortened at least once (the merit test that keeps a step
     from pushing points across stick, slip and free: src/augmentation.cpp), and every
     shortening was called for (the longer step left |R| above the step's start).
@@ -34,6 +38,15 @@ if s:
     T.check(sum(cuts) == 0, f"no step cut ({cuts})")
     T.check(max(newton[1:]) <= 20, f"steps 2-10: at most 20 Newton iterations each ({max(newton[1:])})")
     T.check(all(b < a for a, b in zip(ratio, ratio[1:])), "the speed ratio falls with the brake torque")
+    stage, guesses = None, 0
+    for e in T.log_events(out):
+        if e.get("step") != 1:
+            continue
+        if e.get("event") == "steady stage":
+            stage = e["stage"]
+        elif e.get("event") == "newton" and stage and not stage.startswith("steady state"):
+            guesses += len(e["residuals"])
+    T.check(0 < guesses <= 16, f"the starting guesses: {guesses} Newton residuals (<= 16)")
     halved = T.log_events(out, "pressure_step_halved")
     T.check(len(halved) > 0, f"the saddle-point step was shortened ({len(halved)} times)")
     T.check(all(e["residual"] > e["start"] for e in halved), "each shortening: the longer step left |R| above the start")
