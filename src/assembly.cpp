@@ -4,9 +4,9 @@
 #include <Teuchos_CommHelpers.hpp>
 
 #include <algorithm>
-#include <map>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <stdexcept>
 
 namespace capstan {
@@ -68,7 +68,7 @@ void Assembly::buildGraph() {
       cores_.appendFreeUnknowns(&dofs(e, 0), dofs.extent(1), gid, cols);
       for (size_t k = 0; k < rows; ++k) graph_->insertGlobalIndices(cols[k], Teuchos::ArrayView<const GO>(cols));
       // A core's unknowns appended above get rows too (the chain rule's).
-      for (size_t k = dofs.extent(1); k < cols.size(); ++k) {  // appended: no duplicates in a row's end
+      for (size_t k = dofs.extent(1); k < cols.size(); ++k) {
         auto& row = coreRows[cols[k]];
         row.insert(row.end(), cols.begin(), cols.end());
       }

@@ -41,7 +41,7 @@ constexpr double kPolishBelow = 10;
 // at 3e-6; 1,274 and 1,273 at 1e-5 (the drive at mu = 1.5 cut: 436). The drive
 // 36 -> 27, the slices 17 -> 8 and 15 -> 6. Only where Newton's solves are
 // direct: with GMRES and a kept LU the 126k-dof drive on 2 ranks took 88
-// Newton iterations and 5,211 Krylov, 339 s, against 38, 1,290 and 77 s.
+// Newton iterations and 5,211 Krylov, 339 s, against 38, 1,288 and 93 s.
 constexpr double kGuessTolerance = 2e-6;
 // A saddle-point step is halved (down to kShortestPressureStep) while the
 // momentum residual it leaves is above kPressureStepMerit x the step's starting
