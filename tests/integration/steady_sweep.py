@@ -7,7 +7,7 @@ ramped to 18 N mm (90% of mu F R) over 10 steps, as scripts/steady-bench.py runs
     Newton iterations;
   * the speed ratio falls with each torque step (more brake, more creep);
   * from rest, the starting guesses (the frictionless footprint and the Tanh stages, one
-    pass each) are solved only to 2e-6 c L^2 (src/augmentation.cpp, kGuessTolerance):
+    pass each) are solved only to 1e-6 c L^2 (src/augmentation.cpp, kGuessTolerance):
     at most 16 Newton residuals together (12 today; 21 with each solved to the step's
     tolerance);
   * the saddle-point step was shortened at least once (the merit test that keeps a step
