@@ -291,7 +291,7 @@ void Restart::restore(Model& model, std::vector<StepRecord>& steps, Timings& ear
     const auto previous = in.getVector<double>();
     predictors_.rotations = in.getVector<double>();
     predictors_.t = in.get<double>();
-    if (!previous.empty() && previous.size() != ud.size())
+    if (!previous.empty() && previous.size() != size_t(ud.size()))
       throw std::runtime_error("holds " + std::to_string(previous.size()) + " predictor values, u has " +
                                std::to_string(ud.size()));
     predictors_.u.assign(previous.size(), 0.0);

@@ -54,6 +54,10 @@ struct StepRecord {
   double time = 0;
   int newton = 0, linear = 0, cutbacks = 0, augmentations = 0;
   int pressureStep = 0;  // Krylov iterations of the saddle-point pressure steps (part of linear)
+  // 1: the step's last solve met its tolerances with Coulomb's stick and slip
+  // frozen (AugmentationLoop's last resort; its answer is one admissible state,
+  // which may not be the one a finer radial mesh converges to: docs/friction.md).
+  int statesFrozen = 0;
   double residual = 0, wall = 0, volumeChange = 0;
   std::vector<CapstanRecord> capstans;
   std::vector<SupportRecord> supports;
@@ -100,6 +104,7 @@ void walkStep(V& v, R& r) {
   v.field("pressure_step_iterations", r.pressureStep);
   v.field("cutbacks", r.cutbacks);
   v.field("augmentations", r.augmentations);
+  v.field("states_frozen", r.statesFrozen);
   v.field("residual_norm", r.residual, Show{"|R|", "%.3e"});
   v.field("max_abs_volume_change", r.volumeChange, Show{"dV", "%.1e"});
   v.list("capstans", r.capstans, [&](auto& c) { walkCapstan(v, c); });

@@ -151,7 +151,8 @@ FINE_NIP = ["Mesh/Cells={3, 120, 8}", "Mesh/Fine Sector={-90, 20, 0.6}", NOFIELD
 def held_fine_nip(label, tag, sets, ranks, newton_budget, cuts_allowed=False, env=None, expect_frozen=None):
     """Runs the drive on a fine nip; checks it converged (with no cut unless CUTS_ALLOWED) and
     points held (the log's held_slips events), the states frozen or not as EXPECT_FROZEN says
-    (its states_frozen event; None: either), within the Newton budget, with no NaN,
+    (its states_frozen event, and the step's states_frozen in summary.json: the last solve
+    frozen; None: either), within the Newton budget, with no NaN,
     |t_f| <= mu t_n, volumes and contact within tolerance. Returns the summary (None if it
     did not run)."""
     p, s, out = T.run_scene(T.input("pinch-roller-steady.xml"), tag, sets=sets, ranks=ranks,
@@ -172,6 +173,8 @@ def held_fine_nip(label, tag, sets, ranks, newton_budget, cuts_allowed=False, en
             f"{held} points held")
     if expect_frozen is not None:
         T.check(frozen == expect_frozen, f"{label}: stick and slip frozen: {frozen} (expected {expect_frozen})")
+        T.check(st["states_frozen"] == int(expect_frozen),
+                f"{label}: summary.json's states_frozen {st['states_frozen']} (expected {int(expect_frozen)})")
     T.check(st["newton_iterations"] <= newton_budget,
             f"{label}: {st['newton_iterations']} Newton iterations (<= {newton_budget})")
     T.check(not has_nan(s) and cap["friction"]["max_traction_ratio"] <= 1 + 1e-9 and
