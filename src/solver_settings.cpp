@@ -1,6 +1,33 @@
 #include "solver_settings.hpp"
 
+#include <cctype>
+
 namespace capstan {
+
+namespace {
+// The first string parameter under `list` (path `at`) that names Ifpack2's
+// block relaxation, as "path = value", or "". In Trilinos 13.2 it crashes on
+// capstan's matrices: as MueLu's smoother on the Hertz ring, block Gauss-Seidel
+// over radial lines segfaulted in its first apply, and the line partitioner
+// (3 equations a node) corrupted the heap at a detection threshold of 0.2
+// (docs/performance.md, "Defaults and why", the MueLu rows).
+std::string blockRelaxationIn(const Teuchos::ParameterList& list, const std::string& at) {
+  for (auto it = list.begin(); it != list.end(); ++it) {
+    const std::string path = at + "/" + list.name(it);
+    const auto& entry = list.entry(it);
+    if (entry.isList()) {
+      const std::string inner = blockRelaxationIn(list.sublist(list.name(it)), path);
+      if (!inner.empty()) return inner;
+    } else if (entry.isType<std::string>()) {
+      std::string squeezed;
+      for (char c : entry.getValue<std::string>(nullptr))
+        if (std::isalpha(static_cast<unsigned char>(c))) squeezed += char(std::toupper(static_cast<unsigned char>(c)));
+      if (squeezed.find("BLOCKRELAXATION") != std::string::npos) return path + " = " + entry.getValue<std::string>(nullptr);
+    }
+  }
+  return "";
+}
+}  // namespace
 
 using Teuchos::ParameterList;
 using S = SolverSettings;
@@ -181,6 +208,13 @@ SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterRe
   if (s.minimumSolvePenaltyAutomatic)
     s.minimumSolvePenalty = s.pressureUpdate == PressureUpdate::SaddlePoint && !friction ? 3e-2 : 1e-2;
   s.nox = sol.sublist("NOX");
+  for (const char* pass : {"Stratimikos", "Ifpack2"}) {
+    const std::string found = blockRelaxationIn(sol.sublist(pass), std::string("Solver/") + pass);
+    if (!found.empty())
+      r.fail(found.substr(0, found.find(" = ")),
+             "Ifpack2's block relaxation (" + found.substr(found.find(" = ") + 3) +
+                 ") crashes on capstan's matrices in Trilinos 13.2; use RELAXATION or CHEBYSHEV");
+  }
   s.stratimikos = sol.sublist("Stratimikos");
   s.belos = sol.sublist("Belos");
   s.ifpack2 = sol.sublist("Ifpack2");

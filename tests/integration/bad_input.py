@@ -262,6 +262,15 @@ case("Solver/Belos: a value Belos refuses (Num Blocks = 0)", good, [good, "Solve
      args=KRYLOV + ["--set", "Solver/Belos/Num Blocks=0"])
 case("Solver/Ifpack2: an unknown name", good, [good, "Solver/Ifpack2", "bogus"],
      args=KRYLOV + ["--set", "Solver/Ifpack2/bogus=0"])
+# Ifpack2's block relaxation crashes on capstan's matrices in Trilinos 13.2: refused
+# wherever it is named (as MueLu's smoother, or Ifpack2's own).
+ML = "Solver/Stratimikos/Preconditioner Types/MueLu"
+case("MueLu: block relaxation as smoother", good, [good, f"{ML}/smoother: type", "block relaxation"],
+     args=["--set", "Solver/Linear Solver=GMRES", "--set", "Solver/Preconditioner=MueLu",
+           "--set", f"{ML}/smoother: type=BLOCK_RELAXATION"])
+case("Solver/Stratimikos: Ifpack2's block relaxation", good,
+     [good, "Solver/Stratimikos/Preconditioner Types/Ifpack2/Prec Type", "block relaxation"],
+     args=KRYLOV + ["--set", "Solver/Stratimikos/Preconditioner Types/Ifpack2/Prec Type=Block Relaxation"])
 
 # --- a capstan that can never touch its faces: warning, the run goes on ------------------------
 far = scene_file("far.xml", edited((POINT, POINT.replace("{3.5, 3.75, 0}", "{3.5, 100, 0}"))))
