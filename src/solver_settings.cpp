@@ -113,13 +113,13 @@ void SolverSettings::declare(ParameterList& sol) {
           "-1: automatic, 3e-2 with the Saddle Point pressure update without friction, 1e-2 otherwise "
           "(and where the pressure loop is monolithic)");
   sol.sublist("NOX", false, "Passed to NOX unchanged, over capstan's defaults");
-  sol.sublist("Stratimikos", false, "Passed to Stratimikos unchanged, over capstan's defaults");
+  sol.sublist("Stratimikos", false, "Passed to Stratimikos unchanged, over capstan's defaults (Ifpack2's block relaxation, which crashes in Trilinos 13.2, is refused)");
   sol.sublist("Belos", false,
               "Passed to the Belos solver (Block GMRES, or Pseudo Block CG with Linear Solver = CG) unchanged, "
               "over capstan's defaults; its names, types and values are checked against the solver's (unused with Direct)");
   sol.sublist("Ifpack2", false,
               "Passed to the Ifpack2 preconditioner (Preconditioner = ILU or Jacobi) unchanged, over capstan's "
-              "defaults (unused with the other preconditioners)");
+              "defaults (unused with the other preconditioners; block relaxation refused)");
 }
 
 SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterReader& r, bool friction,
