@@ -1,5 +1,6 @@
 #include "steady_rolling.hpp"
 
+#include <chrono>
 #include <cmath>
 #include <limits>
 
@@ -61,7 +62,10 @@ bool SteadyRolling::solve(double t, StepRecord& rec, std::string& failure) {
     return started_;
   }
   const auto before = m_.snapshot();
-  if (solveStage(t, "steady state", rec, failure)) {
+  announceStages_ = false;
+  const bool converged = solveStage(t, "steady state", rec, failure);
+  announceStages_ = true;
+  if (converged) {
     wideRetryUsed_ = false;
     return true;
   }
@@ -201,7 +205,13 @@ bool SteadyRolling::solveStage(double t, const char* what, StepRecord& rec, std:
   if (log_.on("newton"))
     log_.event("newton", format("steady rolling: %s", what),
                json::Object().add("event", json::string("steady stage")).add("stage", json::string(what)));
-  return augmentation_.solve(t, m_.forceScale, rec, failure, passLimit);
+  const int newtonBefore = rec.newton;
+  const auto clock = std::chrono::steady_clock::now();
+  const bool ok = augmentation_.solve(t, m_.forceScale, rec, failure, passLimit);
+  if (announceStages_)
+    log_.progress(format("  %s: %s, newton=%d, %.2fs", what, ok ? "done" : "failed", rec.newton - newtonBefore,
+                         std::chrono::duration<double>(std::chrono::steady_clock::now() - clock).count()));
+  return ok;
 }
 
 void SteadyRolling::holdCores(bool hold) {

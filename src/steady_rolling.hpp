@@ -67,6 +67,9 @@ class SteadyRolling {
   Predictors& predictors_;
   bool started_;
   bool wideRetryUsed_ = false;  // since the last converged steady state
+  // Whether each stage gets a progress line: the start from rest's and a
+  // retry's (minutes on a fine nip), not a continuation step's one solve.
+  bool announceStages_ = true;
 };
 
 }  // namespace capstan
