@@ -10,6 +10,8 @@ ramped to 18 N mm (90% of mu F R) over 10 steps, as scripts/steady-bench.py runs
     pass each) are solved only to 1e-7 c L^2 (src/augmentation.cpp, kGuessTolerance):
     at most 18 Newton residuals together (15 today; 21 with each solved to the step's
     tolerance);
+  * a progress line for each stage of the start from rest (their Newton iterations add up
+    to the step's), none for the continuation steps;
   * the saddle-point step was shortened at least once (the merit test that keeps a step
     from pushing points across stick, slip and free: src/augmentation.cpp), and every
     shortening was called for (the longer step left |R| above the step's start).
@@ -47,6 +49,15 @@ if s:
         elif e.get("event") == "newton" and stage and not stage.startswith("steady state"):
             guesses += len(e["residuals"])
     T.check(0 < guesses <= 18, f"the starting guesses: {guesses} Newton residuals (<= 18)")
+    # Progress: a line for each stage of the start from rest, none for a continuation step.
+    progress = [e for e in T.log_events(out) if e.get("topic") == "progress"]
+    stages = [e for e in T.log_events(out, "steady stage") if e.get("step") == 1]
+    stage_lines = [e["text"] for e in progress if ": done, newton=" in e["text"] or ": failed, newton=" in e["text"]]
+    T.check(len(stage_lines) == len(stages) > 0 and all(e.get("step") == 1 for e in progress
+                                                         if e["text"] in stage_lines),
+            f"a progress line for each of step 1's {len(stages)} stages ({len(stage_lines)}), none after")
+    T.check(sum(int(t.split("newton=")[1].split(",")[0]) for t in stage_lines) == newton[0],
+            "the stages' Newton iterations add up to step 1's")
     halved = T.log_events(out, "pressure_step_halved")
     T.check(len(halved) > 0, f"the saddle-point step was shortened ({len(halved)} times)")
     T.check(all(e["residual"] > e["start"] for e in halved), "each shortening: the longer step left |R| above the start")
