@@ -436,16 +436,22 @@ bool AugmentationLoop::saddlePointPressureStep(double t, Vector& f, bool volumeM
   } catch (const std::exception& e) {  // e.g. a preconditioner that cannot be built: a plain pass
     failure = e.what();
   }
-  if (!m_.newton->agree(failure).empty()) return false;
+  if (const std::string why = m_.newton->agree(failure); !why.empty()) {
+    if (log_.on("newton"))
+      log_.event("newton", format("pressure step failed (%s): a plain pass instead", why.c_str()),
+                 eventOf("pressure_step_failed"));
+    return false;
+  }
   rec.linear += step.iterations;
   rec.pressureStep += step.iterations;
   if (log_.on("newton"))
     log_.event("newton",
-             format("pressure step: %d GMRES iterations, residual reduced %.2e, volume error left %.2e "
+             format("pressure step: %d GMRES iterations%s, residual reduced %.2e, volume error left %.2e "
                     "(stopped on the prediction after Newton %.2e, target %.2e, %d checks), %d contact and stick rows; %.3f s",
-                    step.iterations, step.reduction, step.volumeResidual, step.volumePredicted,
+                    step.iterations, step.lu ? " (LU)" : "", step.reduction, step.volumeResidual, step.volumePredicted,
                     step.predictionTarget, step.predictions, step.contactRows, since(stepStart)),
              eventOf("pressure_step").add("iterations", json::number(step.iterations))
+                 .add("lu", step.lu ? "true" : "false")
                  .add("reduction", json::number(step.reduction))
                  .add("volume_error", json::number(step.volumeResidual))
                  .add("volume_predicted", json::number(step.volumePredicted))
@@ -453,6 +459,9 @@ bool AugmentationLoop::saddlePointPressureStep(double t, Vector& f, bool volumeM
                  .add("predictions", json::number(step.predictions))
                  .add("contact_rows", json::number(step.contactRows))
                  .add("seconds", json::number(since(stepStart))));
+  if (!step.luRefused.empty() && log_.on("newton"))
+    log_.event("newton", "pressure step: its block matrix not factored (" + step.luRefused + "): Block from here on",
+               eventOf("pressure_step_lu_refused"));
   lastStepShortened_ = false;
   if (!(step.reduction < 1)) return false;
   // The step's start, to scale it back from (the constraint rows are the

@@ -15,10 +15,15 @@ namespace {
 // and "The Laplacian's inverse").
 constexpr double kLaplacianWeight = 0.15;
 constexpr int kLaplacianIterations = 30;
+// Preconditioner::Auto turns to the factored block matrix for the rest of the
+// run after a step of more than this many GMRES iterations. A factorisation
+// costs about as much as 20-40 of them; the shipped drive's steps take 3-14,
+// a fine nip's 50-2,000 (docs/performance.md, "Defaults and why").
+constexpr int kLUAfterIterations = 50;
 }  // namespace
 
-PressureStep::PressureStep(Assembly& assembly, Schur schur)
-    : assembly_(assembly), effectRows_(assembly.effects().size()), schur_(schur) {
+PressureStep::PressureStep(Assembly& assembly, Schur schur, Preconditioner preconditioner)
+    : assembly_(assembly), effectRows_(assembly.effects().size()), schur_(schur), preconditioner_(preconditioner) {
   scratch_ = rcp(new Vector(assembly_.dofMap()));
   residualU_ = rcp(new Vector(assembly_.dofMap()));
   predictU_ = rcp(new Vector(assembly_.dofMap()));
@@ -237,6 +242,10 @@ void PressureStep::applySystem(const CrsMatrix& K, const Block& x, Block& y) con
 }
 
 void PressureStep::applyPreconditioner(const Inverse& Kinv, const Block& r, Block& z) {
+  if (useLU_) {
+    lu_->solve(*r.u, *r.c, *z.u, *z.c);
+    return;
+  }
   // z_c = (w S)^-1 r_c, then z_u = K~^-1 (r_u - B F z_c)
   z.c->elementWiseMultiply(1.0, *schurInverse_, *r.c, 0.0);
   if (schur_ == Schur::Laplacian) {
@@ -285,7 +294,24 @@ PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv
                                          std::vector<Kokkos::View<double*>>& dmu) {
   Kokkos::Timer timer;
   fillRows();
-  if (schur_ == Schur::Laplacian) buildVolumeLaplacian(K);
+  useLU_ = preconditioner_ == Preconditioner::LU || luChosen_;
+  if (useLU_) {
+    if (!lu_) lu_ = std::make_unique<SaddlePointLU>();
+    RCP<const CrsMatrix> T = columns_;
+    if (T.is_null()) {  // the rows' forces on the positions: F G
+      auto FG = rcp(new CrsMatrix(*gradient_, Teuchos::Copy));
+      FG->leftScale(*force_);
+      T = FG;
+    }
+    try {
+      lu_->factor(K, *gradient_, *T, *weight_, *diagonal_, *schurInverse_);
+    } catch (const std::runtime_error& e) {  // MUMPS refused it (every rank alike): Block from here on
+      useLU_ = luChosen_ = false;
+      preconditioner_ = Preconditioner::Block;
+      luRefused_ = e.what();
+    }
+  }
+  if (!useLU_ && schur_ == Schur::Laplacian) buildVolumeLaplacian(K);
   Result result;
   // Right-hand side: (-R, -w .* c).
   Block rhs = newBlock();
@@ -406,6 +432,10 @@ PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv
     if (volumeTarget > 0) volumeLeft = volumeError(*r.c);
     if (!progress) break;  // stagnated: keep what there is (the loop checks the outcome)
   }
+  if (preconditioner_ == Preconditioner::Auto && result.iterations > kLUAfterIterations) luChosen_ = true;
+  result.lu = useLU_;
+  result.luRefused = luRefused_;
+  luRefused_.clear();
   result.reduction = beta0 > 0 ? beta / beta0 : 0.0;
   result.initial = beta0;
   lastPredicted_ = result.reduction < 1 ? result.volumePredicted : 0.0;  // a step without progress is not taken

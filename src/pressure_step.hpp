@@ -50,9 +50,12 @@
 #pragma once
 
 #include <functional>
+#include <memory>
+#include <string>
 #include <vector>
 
 #include "assembly.hpp"
+#include "saddle_point_lu.hpp"
 
 namespace capstan {
 
@@ -60,7 +63,12 @@ class PressureStep {
  public:
   // How the constraint block's Schur complement is approximated (above).
   enum class Schur { Diagonal, Laplacian };
-  explicit PressureStep(Assembly& assembly, Schur schur = Schur::Laplacian);
+  // GMRES's preconditioner: Block (K^-1 and the Schur approximation), LU (the
+  // whole block matrix factored: SaddlePointLU), or Auto (Block, then LU for
+  // the rest of the run once a step has taken more than kLUAfterIterations).
+  enum class Preconditioner { Block, LU, Auto };
+  explicit PressureStep(Assembly& assembly, Schur schur = Schur::Laplacian,
+                        Preconditioner preconditioner = Preconditioner::Block);
 
   // z = K~^-1 r, an approximate inverse of K.
   using Inverse = std::function<void(const Vector& r, Vector& z)>;
@@ -73,6 +81,8 @@ class PressureStep {
     double predictionTarget = 0; // the target the prediction had to meet (volumeTarget / the miss ratio)
     int predictions = 0;         // stop-rule checks of that prediction (each one K~^-1)
     int contactRows = 0;        // contact points in the step (all ranks)
+    bool lu = false;            // preconditioned by the factored block matrix (else block-triangular)
+    std::string luRefused;      // non-empty: MUMPS refused to factor it (why), Block from then on
   };
   // At the last evaluation (f its residual, K its tangent, the effects' states
   // and the positions): dx (owned dofs, zero on held ones) and dmu.
@@ -165,6 +175,11 @@ class PressureStep {
   RCP<Vector> volumeRowsOverW_;       // 1 / w_j on the volume rows, 0 elsewhere
   RCP<Vector> volumeRows_;            // 1 on the volume rows, 0 elsewhere
   mutable RCP<Vector> cgR_, cgP_, cgQ_, cgZ_, laplacianIn_, laplacianOut_;
+  Preconditioner preconditioner_;
+  std::unique_ptr<SaddlePointLU> lu_;  // the whole block matrix factored (useLU_)
+  bool useLU_ = false;                 // this step's preconditioner: lu_
+  bool luChosen_ = false;              // Auto: a step took more than kLUAfterIterations
+  std::string luRefused_;              // why MUMPS refused this step's factorisation (then Block)
   double seconds_ = 0;
   double lastPredicted_ = 0;  // the last step's prediction, until measured (0: none)
   double missRatio_ = 1;      // measured / predicted, last measured

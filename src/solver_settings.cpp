@@ -105,6 +105,12 @@ void SolverSettings::declare(ParameterList& sol) {
           "Newton's (its last factorisation, the tangent one Newton step before the converged state) | New (one "
           "made at the converged state). Newton's: the steady drive 0.86 against 1.04 s, the quasi-static drive "
           "9.05 against 9.77 s, the same Newton iterations (docs/performance.md, \"Defaults and why\")");
+  sol.set("Pressure Step Preconditioner", std::string("Auto"),
+          "The saddle-point step's GMRES preconditioner: Block (K^-1 and the Schur approximation above) | LU (the "
+          "step's whole block matrix factored by MUMPS, its repeated stick and contact rows regularised: 1-3 "
+          "iterations a step) | Auto (Block, then LU for the rest of the run once a step has taken more than 50 "
+          "iterations, where Newton's solves are direct: fine nips' thousands of stick rows; docs/performance.md, "
+          "\"Defaults and why\")");
   sol.set("Pressure Acceleration Depth", 5,
           "Anderson acceleration depth of the pressure loop (0 = plain pbar <- p(x))");
   sol.set("Minimum Solve Penalty", -1.0,
@@ -190,6 +196,11 @@ SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterRe
   s.pressureStepSchur = r.choice(sol, at, "Pressure Step Schur",
                                  std::vector<std::pair<const char*, Schur>>{
                                      {"Auto", Schur::Auto}, {"Laplacian", Schur::Laplacian}, {"Diagonal", Schur::Diagonal}});
+  s.pressureStepPreconditioner = r.choice(sol, at, "Pressure Step Preconditioner",
+                                          std::vector<std::pair<const char*, StepPreconditioner>>{
+                                              {"Auto", StepPreconditioner::Auto},
+                                              {"Block", StepPreconditioner::Block},
+                                              {"LU", StepPreconditioner::LU}});
   s.pressureStepOnNewtonsFactors =
       r.choice(sol, at, "Pressure Step Factorisation",
                std::vector<std::pair<const char*, bool>>{{"Newton's", true}, {"New", false}});

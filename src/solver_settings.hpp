@@ -23,6 +23,7 @@ struct SolverSettings {
   enum class LineSearch { Backtrack, Polynomial, FullStep };
   enum class PressureUpdate { SaddlePoint, Anderson };  // Auto is resolved by parse()
   enum class Schur { Auto, Laplacian, Diagonal };
+  enum class StepPreconditioner { Auto, Block, LU };
 
   LinearSolver linearSolver{};
   int directSolverMaxDofs = 0;  // 0: automatic (resolved())
@@ -52,6 +53,12 @@ struct SolverSettings {
   // With a direct solver, the saddle-point step after a Newton solve
   // preconditions with Newton's last factorisation (false: a new one).
   bool pressureStepOnNewtonsFactors = true;
+  // The saddle-point step's GMRES preconditioner: block-triangular (K^-1 and
+  // the Schur approximation) or the whole block matrix factored by MUMPS
+  // (src/saddle_point_lu.hpp); Auto: the first, then the second for the rest
+  // of the run once a step has taken more than kStepLUAfter iterations, where
+  // Newton's solves are direct.
+  StepPreconditioner pressureStepPreconditioner{};
   int pressureAccelerationDepth = 0;
   double minimumSolvePenalty = 0;  // resolved: > 0
   // Automatic (-1): Model lowers it to kMonolithicSolvePenalty where the loop

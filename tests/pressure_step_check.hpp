@@ -50,16 +50,19 @@ struct StepCheck {
 };
 
 inline StepCheck checkPressureStep(Assembly& assembly, NewtonSolver& newton, const Vector& u, const Vector& f,
-                                   const CrsMatrix& W) {
+                                   const CrsMatrix& W,
+                                   PressureStep::Preconditioner preconditioner = PressureStep::Preconditioner::Block,
+                                   Vector* dxOut = nullptr) {
   auto comm = Tpetra::getDefaultComm();
   StepCheck out;
   const auto c0 = constraintValues(assembly);
 
   std::vector<Kokkos::View<double*>> dmu;
-  PressureStep step(assembly);
+  PressureStep step(assembly, PressureStep::Schur::Laplacian, preconditioner);
   Vector dx(assembly.dofMap());
   out.result = step.solve(W, newton.approximateInverse(), f, 1e-12, 0.0, 500, dx, dmu);
   EXPECT_LT(out.result.reduction, 1e-11);
+  if (dxOut) dxOut->update(1.0, dx, 0.0);
 
   // Momentum rows.
   std::vector<std::vector<double>> mu0;
