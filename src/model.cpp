@@ -46,13 +46,15 @@ Model::Model(const Scene& scene_, const RCP<const Comm>& comm_)
   if (scene.solver.pressureUpdate == S::PressureUpdate::SaddlePoint) {
     const auto schur = scene.solver.pressureStepSchur;
     const bool laplacian = schur == S::Schur::Laplacian || (schur == S::Schur::Auto && newton->iterative());
-    // The factored block matrix only where Newton's own solves are direct:
-    // above the direct solver's size it would be the largest factorisation.
+    // Auto: the factored block matrix for steady rolling above
+    // kStepLUAboveDofs unknowns where Newton's own solves are direct (above the
+    // direct solver's size it would be the largest factorisation of all).
     const auto choice = scene.solver.pressureStepPreconditioner;
-    const auto preconditioner = choice == S::StepPreconditioner::LU ? PressureStep::Preconditioner::LU
-                                : choice == S::StepPreconditioner::Auto && !newton->iterative()
-                                    ? PressureStep::Preconditioner::Auto
-                                    : PressureStep::Preconditioner::Block;
+    const long dofs = long(assembly->dofMap()->getGlobalNumElements());
+    const bool lu = choice == S::StepPreconditioner::LU ||
+                    (choice == S::StepPreconditioner::Auto && scene.analysis.steady() && !newton->iterative() &&
+                     dofs > S::kStepLUAboveDofs);
+    const auto preconditioner = lu ? PressureStep::Preconditioner::LU : PressureStep::Preconditioner::Block;
     pressureStep = std::make_unique<PressureStep>(
         *assembly, laplacian ? PressureStep::Schur::Laplacian : PressureStep::Schur::Diagonal, preconditioner);
     monolithic = scene.solver.monolithic && !(scene.solver.monolithicIfExact && newton->iterative());

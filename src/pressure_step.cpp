@@ -15,11 +15,6 @@ namespace {
 // and "The Laplacian's inverse").
 constexpr double kLaplacianWeight = 0.15;
 constexpr int kLaplacianIterations = 30;
-// Preconditioner::Auto turns to the factored block matrix for the rest of the
-// run after a step of more than this many GMRES iterations. A factorisation
-// costs about as much as 20-40 of them; the shipped drive's steps take 3-14,
-// a fine nip's 50-2,000 (docs/performance.md, "Defaults and why").
-constexpr int kLUAfterIterations = 50;
 }  // namespace
 
 PressureStep::PressureStep(Assembly& assembly, Schur schur, Preconditioner preconditioner)
@@ -294,7 +289,7 @@ PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv
                                          std::vector<Kokkos::View<double*>>& dmu) {
   Kokkos::Timer timer;
   fillRows();
-  useLU_ = preconditioner_ == Preconditioner::LU || luChosen_;
+  useLU_ = preconditioner_ == Preconditioner::LU;
   if (useLU_) {
     if (!lu_) lu_ = std::make_unique<SaddlePointLU>();
     RCP<const CrsMatrix> T = columns_;
@@ -306,7 +301,7 @@ PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv
     try {
       lu_->factor(K, *gradient_, *T, *weight_, *diagonal_, *schurInverse_);
     } catch (const std::runtime_error& e) {  // MUMPS refused it (every rank alike): Block from here on
-      useLU_ = luChosen_ = false;
+      useLU_ = false;
       preconditioner_ = Preconditioner::Block;
       luRefused_ = e.what();
     }
@@ -432,7 +427,6 @@ PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv
     if (volumeTarget > 0) volumeLeft = volumeError(*r.c);
     if (!progress) break;  // stagnated: keep what there is (the loop checks the outcome)
   }
-  if (preconditioner_ == Preconditioner::Auto && result.iterations > kLUAfterIterations) luChosen_ = true;
   result.lu = useLU_;
   result.luRefused = luRefused_;
   luRefused_.clear();

@@ -63,10 +63,9 @@ class PressureStep {
  public:
   // How the constraint block's Schur complement is approximated (above).
   enum class Schur { Diagonal, Laplacian };
-  // GMRES's preconditioner: Block (K^-1 and the Schur approximation), LU (the
-  // whole block matrix factored: SaddlePointLU), or Auto (Block, then LU for
-  // the rest of the run once a step has taken more than kLUAfterIterations).
-  enum class Preconditioner { Block, LU, Auto };
+  // GMRES's preconditioner: Block (K^-1 and the Schur approximation) or LU
+  // (the whole block matrix factored: SaddlePointLU).
+  enum class Preconditioner { Block, LU };
   explicit PressureStep(Assembly& assembly, Schur schur = Schur::Laplacian,
                         Preconditioner preconditioner = Preconditioner::Block);
 
@@ -178,7 +177,6 @@ class PressureStep {
   Preconditioner preconditioner_;
   std::unique_ptr<SaddlePointLU> lu_;  // the whole block matrix factored (useLU_)
   bool useLU_ = false;                 // this step's preconditioner: lu_
-  bool luChosen_ = false;              // Auto: a step took more than kLUAfterIterations
   std::string luRefused_;              // why MUMPS refused this step's factorisation (then Block)
   double seconds_ = 0;
   double lastPredicted_ = 0;  // the last step's prediction, until measured (0: none)

@@ -108,9 +108,9 @@ void SolverSettings::declare(ParameterList& sol) {
   sol.set("Pressure Step Preconditioner", std::string("Auto"),
           "The saddle-point step's GMRES preconditioner: Block (K^-1 and the Schur approximation above) | LU (the "
           "step's whole block matrix factored by MUMPS, its repeated stick and contact rows regularised: 1-3 "
-          "iterations a step) | Auto (Block, then LU for the rest of the run once a step has taken more than 50 "
-          "iterations, where Newton's solves are direct: fine nips' thousands of stick rows; docs/performance.md, "
-          "\"Defaults and why\")");
+          "iterations a step) | Auto (LU for steady rolling above 10,000 unknowns where Newton's solves are direct, "
+          "Block elsewhere: a fine nip's thousands of stick rows take Block 50-2,000 iterations a step; "
+          "docs/performance.md, \"Defaults and why\")");
   sol.set("Pressure Acceleration Depth", 5,
           "Anderson acceleration depth of the pressure loop (0 = plain pbar <- p(x))");
   sol.set("Minimum Solve Penalty", -1.0,
