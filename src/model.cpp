@@ -47,8 +47,9 @@ Model::Model(const Scene& scene_, const RCP<const Comm>& comm_)
     const auto schur = scene.solver.pressureStepSchur;
     const bool laplacian = schur == S::Schur::Laplacian || (schur == S::Schur::Auto && newton->iterative());
     // Auto: the factored block matrix for steady rolling above
-    // kStepLUAboveDofs unknowns where Newton's own solves are direct (above the
-    // direct solver's size it would be the largest factorisation of all).
+    // kStepLUAboveDofs unknowns where Newton's solves factor the matrix (a
+    // direct solver, or GMRES with the LU preconditioner; next to multigrid it
+    // would be the largest factorisation of the run).
     const auto choice = scene.solver.pressureStepPreconditioner;
     const long dofs = long(assembly->dofMap()->getGlobalNumElements());
     const bool lu = choice == S::StepPreconditioner::LU ||

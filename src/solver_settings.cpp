@@ -108,7 +108,7 @@ void SolverSettings::declare(ParameterList& sol) {
   sol.set("Pressure Step Preconditioner", std::string("Auto"),
           "The saddle-point step's GMRES preconditioner: Block (K^-1 and the Schur approximation above) | LU (the "
           "step's whole block matrix factored by MUMPS, its repeated stick and contact rows regularised: 1-3 "
-          "iterations a step) | Auto (LU for steady rolling above 10,000 unknowns where Newton's solves are direct, "
+          "iterations a step) | Auto (LU for steady rolling above 10,000 unknowns where Newton's solves factor the matrix (direct or the LU preconditioner), "
           "Block elsewhere: a fine nip's thousands of stick rows take Block 50-2,000 iterations a step; "
           "docs/performance.md, \"Defaults and why\")");
   sol.set("Pressure Acceleration Depth", 5,

@@ -56,7 +56,8 @@ struct SolverSettings {
   // The saddle-point step's GMRES preconditioner: block-triangular (K^-1 and
   // the Schur approximation) or the whole block matrix factored by MUMPS
   // (src/saddle_point_lu.hpp); Auto: the factored matrix for steady rolling
-  // above kStepLUAboveDofs unknowns where Newton's solves are direct. Its
+  // above kStepLUAboveDofs unknowns where Newton's solves factor the matrix
+  // (direct, or the LU preconditioner). Its
   // factorisation costs 20-40 GMRES iterations of the block one: the shipped
   // drive (4,806 unknowns, 3-14 a step) 0.95 against 0.88 s; its fine nips
   // (13,000-17,000, 50-2,000 a step) 2-8x faster (docs/performance.md).
