@@ -61,6 +61,8 @@ class AugmentationLoop {
   bool solve(double t, double bare, StepRecord& rec, std::string& failure, int passLimit = 0);
 
  private:
+  // solve() once, with the step's preconditioner as it stands.
+  bool solveOnce(double t, double bare, StepRecord& rec, std::string& failure, int passLimit);
   // How a pass starts: a step alone or a Newton solve (or one polishing Newton
   // step), and the residual it starts from and is to reach.
   struct Pass {

@@ -111,6 +111,10 @@ class PressureStep {
   void shortened() { lastPredicted_ = 0; }
   // Constraint rows of the last solve (all ranks): volumes and contact points.
   long rows() const { return rows_; }
+  // Whether the steps factor the whole block matrix (Preconditioner::LU), and
+  // the switch back to the block-triangular preconditioner for good.
+  bool factorsBlockMatrix() const { return preconditioner_ == Preconditioner::LU; }
+  void useBlockPreconditioner() { preconditioner_ = Preconditioner::Block; }
   double seconds() const { return seconds_; }
 
  private:
