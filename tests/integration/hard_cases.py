@@ -42,21 +42,24 @@ cells on 3 radial cells, the sector centred on the nip), where Coulomb's stick a
 cycle from pass to pass at the stick zone's edge (before the hold it never converged):
 it converges with points held in slip (the log's held_slips events), no NaN, |t_f| <= mu t_n
 everywhere, volumes and contact within tolerance. On 1 rank with no cut in at most 120
-Newton iterations, its states not frozen. On 2 ranks MUMPS' dynamic scheduling moves the
-round-off from run to run, and with it which points cycle: 27 runs here converged as 1
-rank does (51-58 Newton iterations, no cut, 44 or 52 points held); one in CI, with the
-build before the freeze (below), failed its first try and converged after a cut (609
-iterations). So on 2 ranks a cut is allowed (the step's recovery), within 1,000
-iterations, and the speed ratio and capstan force must meet the 1-rank run's to 5e-5 (no
-cut: 1.1e-5 at most; the cut path 3.8e-5; Coulomb's path level is 2.3e-5).
+Newton iterations, its states not frozen. Its saddle-point steps factor their whole block
+matrix (Solver/Pressure Step Preconditioner = Auto above 10,000 unknowns): 1 and 2 ranks
+then took the same 53 Newton iterations, 16 points held, 1.1e-14 apart. With the
+block-triangular step MUMPS' dynamic scheduling moved the round-off from run to run on 2
+ranks, and with it which points cycle: 27 runs converged as 1 rank did (51-58 Newton
+iterations, 44 or 52 points held, within 1.1e-5); one in CI failed its first try and
+converged after a cut (609 iterations, 3.8e-5). So on 2 ranks a cut is still allowed (the
+step's recovery), within 1,000 iterations, and the speed ratio and capstan force must meet
+the 1-rank run's to 5e-5 (Coulomb's path level is 2.3e-5).
 
 And with uniform radial cells under that nip (3x160x8, Outer Cell Ratio = 1), where the
 chatter is no 2-cycle: the loop's last resort freezes every point's state after 8 passes
 without gain (in stick until its traction leaves the cone, then in slip: AugmentationLoop,
 kFreezeAfterPasses), and it converges with no cut, with OpenBLAS' AVX2 kernels
-(OPENBLAS_CORETYPE=Haswell) and its SSE kernels (Nehalem), whose round-off differs. Before
-the freeze it converged with the first (57 Newton iterations) and not with the second (not
-within 11 minutes): docs/steady-rolling.md, "Stick and slip that cycle".
+(OPENBLAS_CORETYPE=Haswell) and its SSE kernels (Nehalem), whose round-off differs (today
+51 Newton iterations with each, speed ratios 5e-14 apart). Before the freeze it converged
+with the first (57 Newton iterations) and not with the second (not within 11 minutes):
+docs/steady-rolling.md, "Stick and slip that cycle".
 """
 import json
 import os
