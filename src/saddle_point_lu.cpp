@@ -1,6 +1,5 @@
 #include "saddle_point_lu.hpp"
 
-#include <Kokkos_Timer.hpp>
 #include <Tpetra_RowMatrixTransposer.hpp>
 
 #include <vector>
@@ -30,7 +29,6 @@ SaddlePointLU::~SaddlePointLU() = default;
 
 void SaddlePointLU::factor(const CrsMatrix& K, const CrsMatrix& G, const CrsMatrix& T, const Vector& w,
                            const Vector& D, const Vector& schurInverse) {
-  Kokkos::Timer timer;
   // The combined rows: this rank's positions, then its constraint rows with
   // their GIDs past every position's.
   const auto uMap = K.getRowMap(), cMap = G.getRowMap();
@@ -86,11 +84,9 @@ void SaddlePointLU::factor(const CrsMatrix& K, const CrsMatrix& G, const CrsMatr
   }
   A->fillComplete(map_, map_);
   mumps_->factor(*A);
-  seconds_ += timer.seconds();
 }
 
 void SaddlePointLU::solve(const Vector& ru, const Vector& rc, Vector& zu, Vector& zc) {
-  Kokkos::Timer timer;
   const size_t nu = ru.getLocalLength(), nc = rc.getLocalLength();
   {
     auto b = b_->getDataNonConst(0);
@@ -105,7 +101,6 @@ void SaddlePointLU::solve(const Vector& ru, const Vector& rc, Vector& zu, Vector
   auto c = zc.getDataNonConst();
   for (size_t i = 0; i < nu; ++i) u[i] = x[i];
   for (size_t j = 0; j < nc; ++j) c[j] = x[nu + j];
-  seconds_ += timer.seconds();
 }
 
 }  // namespace capstan

@@ -33,14 +33,12 @@ class SaddlePointLU {
               const Vector& schurInverse);
   // z = the block matrix' inverse applied to r, block by block.
   void solve(const Vector& ru, const Vector& rc, Vector& zu, Vector& zc);
-  double seconds() const { return seconds_; }
 
  private:
   std::unique_ptr<MumpsSolver> mumps_;
   Teuchos::RCP<const Map> map_;  // positions' rows, then the constraint rows (GIDs offset)
   Teuchos::RCP<const Map> uMap_, cMap_;
   Teuchos::RCP<Tpetra::MultiVector<>> b_, x_;
-  double seconds_ = 0;
 };
 
 }  // namespace capstan
