@@ -290,6 +290,7 @@ PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv
   Kokkos::Timer timer;
   fillRows();
   useLU_ = preconditioner_ == Preconditioner::LU;
+  std::string luRefused;
   if (useLU_) {
     if (!lu_) lu_ = std::make_unique<SaddlePointLU>();
     RCP<const CrsMatrix> T = columns_;
@@ -303,7 +304,7 @@ PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv
     } catch (const std::runtime_error& e) {  // MUMPS refused it (every rank alike): Block from here on
       useLU_ = false;
       preconditioner_ = Preconditioner::Block;
-      luRefused_ = e.what();
+      luRefused = e.what();
     }
   }
   if (!useLU_ && schur_ == Schur::Laplacian) buildVolumeLaplacian(K);
@@ -428,8 +429,7 @@ PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv
     if (!progress) break;  // stagnated: keep what there is (the loop checks the outcome)
   }
   result.lu = useLU_;
-  result.luRefused = luRefused_;
-  luRefused_.clear();
+  result.luRefused = luRefused;
   result.reduction = beta0 > 0 ? beta / beta0 : 0.0;
   result.initial = beta0;
   lastPredicted_ = result.reduction < 1 ? result.volumePredicted : 0.0;  // a step without progress is not taken

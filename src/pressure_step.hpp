@@ -181,7 +181,6 @@ class PressureStep {
   Preconditioner preconditioner_;
   std::unique_ptr<SaddlePointLU> lu_;  // the whole block matrix factored (useLU_)
   bool useLU_ = false;                 // this step's preconditioner: lu_
-  std::string luRefused_;              // why MUMPS refused this step's factorisation (then Block)
   double seconds_ = 0;
   double lastPredicted_ = 0;  // the last step's prediction, until measured (0: none)
   double missRatio_ = 1;      // measured / predicted, last measured
