@@ -1,6 +1,7 @@
 #include "augmentation.hpp"
 
 #include "errors.hpp"
+#include "stopwatch.hpp"
 
 #include <Teuchos_CommHelpers.hpp>
 
@@ -12,9 +13,6 @@
 namespace capstan {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // The saddle-point pressure step's GMRES tolerance (relative): the volume
 // error then falls about 1000x per pass in the linear regime.

@@ -14,15 +14,13 @@
 #include "errors.hpp"
 #include "json.hpp"
 #include "step_figures.hpp"
+#include "stopwatch.hpp"
 
 namespace capstan {
 
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
 
 namespace {
-
-double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // Per rank: peak resident memory (Linux reports ru_maxrss in KiB), memory in
 // transparent huge pages now, and page faults so far (src/heap_tunables.hpp),

@@ -9,13 +9,11 @@
 #include "outputs.hpp"
 #include "restart.hpp"
 #include "step_figures.hpp"
+#include "stopwatch.hpp"
 
 namespace capstan {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 class Simulation {
  public:

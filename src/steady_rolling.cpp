@@ -1,12 +1,12 @@
 #include "steady_rolling.hpp"
 
-#include <chrono>
 #include <cmath>
 #include <limits>
 
 #include "effects/steady_friction.hpp"
 #include "newton.hpp"
 #include "rolling.hpp"
+#include "stopwatch.hpp"
 
 namespace capstan {
 
@@ -62,10 +62,7 @@ bool SteadyRolling::solve(double t, StepRecord& rec, std::string& failure) {
     return started_;
   }
   const auto before = m_.snapshot();
-  announceStages_ = false;
-  const bool converged = solveStage(t, "steady state", rec, failure);
-  announceStages_ = true;
-  if (converged) {
+  if (solveStage(t, "steady state", rec, failure, 0, false)) {
     wideRetryUsed_ = false;
     return true;
   }
@@ -197,7 +194,8 @@ bool SteadyRolling::startThroughWideLaws(double t, const std::vector<SteadyFrict
   return ok;
 }
 
-bool SteadyRolling::solveStage(double t, const char* what, StepRecord& rec, std::string& failure, int passLimit) {
+bool SteadyRolling::solveStage(double t, const char* what, StepRecord& rec, std::string& failure, int passLimit,
+                               bool announce) {
   auto& assembly = *m_.assembly;
   assembly.applyConstraints(*m_.u, t);
   // Newton's tolerance relative to the body's force scale c L^2 (the
@@ -206,11 +204,11 @@ bool SteadyRolling::solveStage(double t, const char* what, StepRecord& rec, std:
     log_.event("newton", format("steady rolling: %s", what),
                json::Object().add("event", json::string("steady stage")).add("stage", json::string(what)));
   const int newtonBefore = rec.newton;
-  const auto clock = std::chrono::steady_clock::now();
+  const auto start = Clock::now();
   const bool ok = augmentation_.solve(t, m_.forceScale, rec, failure, passLimit);
-  if (announceStages_)
+  if (announce)
     log_.progress(format("  %s: %s, newton=%d, %.2fs", what, ok ? "done" : "failed", rec.newton - newtonBefore,
-                         std::chrono::duration<double>(std::chrono::steady_clock::now() - clock).count()));
+                         since(start)));
   return ok;
 }
 

@@ -57,7 +57,10 @@ class SteadyRolling {
   bool steadyStateWithStickRetries(double t, const std::vector<SteadyFrictionEffect*>& widened, StepRecord& rec,
                                    std::string& failure);
   // passLimit > 0: a starting guess, that many augmentation passes.
-  bool solveStage(double t, const char* what, StepRecord& rec, std::string& failure, int passLimit = 0);
+  // announce: a progress line when it ends (the start's stages and a step's
+  // retries take minutes on a fine nip; a continuation step's one solve not).
+  bool solveStage(double t, const char* what, StepRecord& rec, std::string& failure, int passLimit = 0,
+                  bool announce = true);
   void holdCores(bool hold);
   void enableFriction(bool on);
 
@@ -67,9 +70,6 @@ class SteadyRolling {
   Predictors& predictors_;
   bool started_;
   bool wideRetryUsed_ = false;  // since the last converged steady state
-  // Whether each stage gets a progress line: the start from rest's and a
-  // retry's (minutes on a fine nip), not a continuation step's one solve.
-  bool announceStages_ = true;
 };
 
 }  // namespace capstan
