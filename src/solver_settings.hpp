@@ -57,10 +57,10 @@ struct SolverSettings {
   // the Schur approximation) or the whole block matrix factored by MUMPS
   // (src/saddle_point_lu.hpp); Auto: the factored matrix for steady rolling
   // above kStepLUAboveDofs unknowns where Newton's solves factor the matrix
-  // (direct, or the LU preconditioner). Its
-  // factorisation costs 20-40 GMRES iterations of the block one: the shipped
-  // drive (4,806 unknowns, 3-14 a step) 0.95 against 0.88 s; its fine nips
-  // (13,000-17,000, 50-2,000 a step) 2-8x faster (docs/performance.md).
+  // (direct, or the LU preconditioner). Its factorisation costs 20-40 GMRES
+  // iterations of the block one: the shipped drive (4,806 unknowns, 3-14 a
+  // step) 0.95 against 0.88 s; its fine nips (10,000-17,000 unknowns, 50-2,000
+  // a step) 1.3-8x faster where they converge with it (docs/performance.md).
   StepPreconditioner pressureStepPreconditioner{};
   static constexpr long kStepLUAboveDofs = 10000;
   int pressureAccelerationDepth = 0;
