@@ -83,30 +83,51 @@ void trsv(const char* uplo, const char* t, const char* diag, const int* n, const
 void scal(const int* n, const float* alpha, float* x, const int* incx) { sscal_(n, alpha, x, incx); }
 void scal(const int* n, const double* alpha, double* x, const int* incx) { dscal_(n, alpha, x, incx); }
 
+template <class T>
+struct Names;
+template <>
+struct Names<float> {
+  static constexpr const char* gemm = "sgemm_";
+  static constexpr const char* trsm = "strsm_";
+};
+template <>
+struct Names<double> {
+  static constexpr const char* gemm = "dgemm_";
+  static constexpr const char* trsm = "dtrsm_";
+};
+
 // C = alpha op(A) op(B) + beta C. With one column (n = 1) this is
 // y = alpha op(A) x + beta y, op(B)'s column x being B's column (stride 1)
 // or, transposed, B's row (stride ldb). GEMV returns at once for an empty
 // A without scaling y, so empty products stay with GEMM.
 template <class T>
-bool gemmByGemv(const char* ta, const char* tb, const int* m, const int* n, const int* k, const T* alpha, const T* a,
-                const int* lda, const T* b, const int* ldb, const T* beta, T* c) {
-  if (*n != 1 || *m <= 0 || *k <= 0 || !enabled()) return false;
-  const int incb = transposed(tb) ? *ldb : 1, one = 1;
-  const bool at = transposed(ta);
-  const int rows = at ? *k : *m, cols = at ? *m : *k;
-  gemv(at ? "T" : "N", &rows, &cols, alpha, a, lda, b, &incb, beta, c, &one);
-  return true;
+void gemm(const char* ta, const char* tb, const int* m, const int* n, const int* k, const T* alpha, const T* a,
+          const int* lda, const T* b, const int* ldb, const T* beta, T* c, const int* ldc, std::size_t lta,
+          std::size_t ltb) {
+  if (*n == 1 && *m > 0 && *k > 0 && enabled()) {
+    const int incb = transposed(tb) ? *ldb : 1, one = 1;
+    const bool at = transposed(ta);
+    const int rows = at ? *k : *m, cols = at ? *m : *k;
+    gemv(at ? "T" : "N", &rows, &cols, alpha, a, lda, b, &incb, beta, c, &one);
+    return;
+  }
+  static const auto blas = blasRoutine<Gemm<T>>(Names<T>::gemm);
+  blas(ta, tb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc, lta, ltb);
 }
 
-// op(A) X = alpha B from the left with one column: X = op(A)^-1 (alpha b).
+// op(A) X = alpha B; from the left with one column: x = op(A)^-1 (alpha b).
 template <class T>
-bool trsmByTrsv(const char* side, const char* uplo, const char* ta, const char* diag, const int* m, const int* n,
-                const T* alpha, const T* a, const int* lda, T* b) {
-  if ((*side != 'L' && *side != 'l') || *n != 1 || *m <= 0 || !enabled()) return false;
-  const int one = 1;
-  if (*alpha != T(1)) scal(m, alpha, b, &one);
-  trsv(uplo, ta, diag, m, a, lda, b, &one);
-  return true;
+void trsm(const char* side, const char* uplo, const char* ta, const char* diag, const int* m, const int* n,
+          const T* alpha, const T* a, const int* lda, T* b, const int* ldb, std::size_t l1, std::size_t l2,
+          std::size_t l3, std::size_t l4) {
+  if ((*side == 'L' || *side == 'l') && *n == 1 && *m > 0 && enabled()) {
+    const int one = 1;
+    if (*alpha != T(1)) scal(m, alpha, b, &one);
+    trsv(uplo, ta, diag, m, a, lda, b, &one);
+    return;
+  }
+  static const auto blas = blasRoutine<Trsm<T>>(Names<T>::trsm);
+  blas(side, uplo, ta, diag, m, n, alpha, a, lda, b, ldb, l1, l2, l3, l4);
 }
 
 }  // namespace
@@ -116,33 +137,25 @@ extern "C" {
 void sgemm_(const char* ta, const char* tb, const int* m, const int* n, const int* k, const float* alpha,
             const float* a, const int* lda, const float* b, const int* ldb, const float* beta, float* c,
             const int* ldc, std::size_t lta, std::size_t ltb) {
-  if (gemmByGemv(ta, tb, m, n, k, alpha, a, lda, b, ldb, beta, c)) return;
-  static const auto blas = blasRoutine<Gemm<float>>("sgemm_");
-  blas(ta, tb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc, lta, ltb);
+  gemm(ta, tb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc, lta, ltb);
 }
 
 void dgemm_(const char* ta, const char* tb, const int* m, const int* n, const int* k, const double* alpha,
             const double* a, const int* lda, const double* b, const int* ldb, const double* beta, double* c,
             const int* ldc, std::size_t lta, std::size_t ltb) {
-  if (gemmByGemv(ta, tb, m, n, k, alpha, a, lda, b, ldb, beta, c)) return;
-  static const auto blas = blasRoutine<Gemm<double>>("dgemm_");
-  blas(ta, tb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc, lta, ltb);
+  gemm(ta, tb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc, lta, ltb);
 }
 
 void strsm_(const char* side, const char* uplo, const char* ta, const char* diag, const int* m, const int* n,
             const float* alpha, const float* a, const int* lda, float* b, const int* ldb, std::size_t l1,
             std::size_t l2, std::size_t l3, std::size_t l4) {
-  if (trsmByTrsv(side, uplo, ta, diag, m, n, alpha, a, lda, b)) return;
-  static const auto blas = blasRoutine<Trsm<float>>("strsm_");
-  blas(side, uplo, ta, diag, m, n, alpha, a, lda, b, ldb, l1, l2, l3, l4);
+  trsm(side, uplo, ta, diag, m, n, alpha, a, lda, b, ldb, l1, l2, l3, l4);
 }
 
 void dtrsm_(const char* side, const char* uplo, const char* ta, const char* diag, const int* m, const int* n,
             const double* alpha, const double* a, const int* lda, double* b, const int* ldb, std::size_t l1,
             std::size_t l2, std::size_t l3, std::size_t l4) {
-  if (trsmByTrsv(side, uplo, ta, diag, m, n, alpha, a, lda, b)) return;
-  static const auto blas = blasRoutine<Trsm<double>>("dtrsm_");
-  blas(side, uplo, ta, diag, m, n, alpha, a, lda, b, ldb, l1, l2, l3, l4);
+  trsm(side, uplo, ta, diag, m, n, alpha, a, lda, b, ldb, l1, l2, l3, l4);
 }
 
 }  // extern "C"
