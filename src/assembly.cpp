@@ -113,7 +113,13 @@ void Assembly::buildTangentSinks() {
   const auto entries = local.graph.entries;
   if (entries.extent(0) > size_t(std::numeric_limits<int>::max()))
     throw std::runtime_error("assembly: a rank's matrix has more than 2^31 entries; run on more ranks");
+  // Rows are sorted: a binary search (G1 2x's 1.5 M look-ups took 20-30 ms
+  // one by one), the whole row where it misses.
   auto find = [&](LO row, LO col) -> int {
+    const auto* first = entries.data() + rowStart(row);
+    const auto* last = entries.data() + rowStart(row + 1);
+    const auto* at = std::lower_bound(first, last, col);
+    if (at != last && *at == col) return int(at - entries.data());
     for (auto j = rowStart(row); j < rowStart(row + 1); ++j)
       if (entries(j) == col) return int(j);
     throw std::logic_error("assembly: an element entry is missing from the matrix graph");
