@@ -5,6 +5,7 @@
 
 #include <Teuchos_CommHelpers.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -208,7 +209,11 @@ bool AugmentationLoop::holdCyclingSlips(int it) {
   // edge back and forth on their way (the 3D drive at 3x160x8 converges so;
   // holding its edge node there moved the speed ratio by 7e-5).
   const bool mayHold = it - bestPass_ >= kHoldAfterPasses;
-  const bool freezeNow = !frozen_ && it - bestPass_ >= kFreezeAfterPasses;
+  // Freezing is friction's last resort: a scene without it has nothing to
+  // freeze, and its loop keeps the plain stall test (kStallPasses).
+  const auto& frictions = m_.assembly->frictions();
+  const bool friction = std::any_of(frictions.begin(), frictions.end(), [](const auto* fr) { return fr != nullptr; });
+  const bool freezeNow = friction && !frozen_ && it - bestPass_ >= kFreezeAfterPasses;
   int local = 0, any = 0;
   for (auto* fr : m_.assembly->frictions())
     if (fr && fr->notePass(mayHold, it - bestPass_ >= kHoldAnyAfterPasses, frozen_ || freezeNow)) local = 1;
