@@ -215,7 +215,7 @@ bool AugmentationLoop::holdCyclingSlips(int it) {
   const bool friction = std::any_of(frictions.begin(), frictions.end(), [](const auto* fr) { return fr != nullptr; });
   const bool freezeNow = friction && !frozen_ && it - bestPass_ >= kFreezeAfterPasses;
   int local = 0, any = 0;
-  for (auto* fr : m_.assembly->frictions())
+  for (auto* fr : frictions)
     if (fr && fr->notePass(mayHold, it - bestPass_ >= kHoldAnyAfterPasses, frozen_ || freezeNow)) local = 1;
   Teuchos::reduceAll(*m_.comm, Teuchos::REDUCE_MAX, local, Teuchos::outArg(any));
   if (freezeNow) {
