@@ -548,10 +548,12 @@ NewtonResult AugmentationLoop::polish(double t, double start) {
 
 bool AugmentationLoop::everyPointSlips() {
   auto& assembly = *m_.assembly;
-  if (assembly.frictions().empty()) return false;
+  const auto& frictions = assembly.frictions();  // one per capstan, null without friction
+  if (std::none_of(frictions.begin(), frictions.end(), [](const auto* f) { return f != nullptr; })) return false;
   assembly.evaluate(*m_.u, nullptr, nullptr);
   long stick = 0, all = 0;
-  for (const auto* f : assembly.frictions()) stick += f->figures().stick;
+  for (const auto* f : frictions)
+    if (f) stick += f->figures().stick;
   Teuchos::reduceAll(*m_.u->getMap()->getComm(), Teuchos::REDUCE_SUM, stick, Teuchos::outArg(all));
   return all == 0;
 }
