@@ -46,6 +46,8 @@ class Assembly {
   const std::vector<ContactEffect*>& contacts() const { return effects_.contacts; }
   // Per capstan (as contacts()): its friction effect, or null without friction.
   const std::vector<FrictionEffect*>& frictions() const { return effects_.frictions; }
+  // The friction effects there are (loops over every friction: no nulls).
+  const std::vector<FrictionEffect*>& frictionsPresent() const { return effects_.frictionsPresent; }
   // The union of all capstans' candidate faces on this rank (4 overlapped node
   // ids each), and for capstan i the union index of each of its faces.
   const std::vector<int>& contactFaceNodes() const { return effects_.contactFaceNodes; }

@@ -5,7 +5,6 @@
 
 #include <Teuchos_CommHelpers.hpp>
 
-#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -109,7 +108,7 @@ json::Object eventOf(const char* name) { return json::Object().add("event", json
 }  // namespace
 
 AugmentationLoop::AugmentationLoop(Model& model, Log& log, bool checkTangent)
-    : m_(model), log_(log), checkTangent_(checkTangent), continuation_(model.assembly->frictions(), log) {}
+    : m_(model), log_(log), checkTangent_(checkTangent), continuation_(model.assembly->frictionsPresent(), log) {}
 
 bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string& failure, int passLimit) {
   if (solveOnce(t, bare, rec, failure, passLimit)) return true;
@@ -139,8 +138,7 @@ bool AugmentationLoop::solveOnce(double t, double bare, StepRecord& rec, std::st
   for (const auto& e : m_.assembly->effects()) maxOuter = std::max(maxOuter, e->maxAugmentations());
   AndersonMixing mixing(sol.pressureAccelerationDepth, m_.comm);
   PassPolicy passes(m_.monolithic);
-  for (auto* fr : m_.assembly->frictions())  // a new solve: every point free (null: a capstan without friction)
-    if (fr) fr->releaseHeldSlips();
+  for (auto* fr : m_.assembly->frictionsPresent()) fr->releaseHeldSlips();  // a new solve: every point free
   frozen_ = false;
   std::optional<StepStart> beforeStep;
   Vector f(m_.u->getMap());
@@ -211,12 +209,11 @@ bool AugmentationLoop::holdCyclingSlips(int it) {
   const bool mayHold = it - bestPass_ >= kHoldAfterPasses;
   // Freezing is friction's last resort: a scene without it has nothing to
   // freeze, and its loop keeps the plain stall test (kStallPasses).
-  const auto& frictions = m_.assembly->frictions();
-  const bool friction = std::any_of(frictions.begin(), frictions.end(), [](const auto* fr) { return fr != nullptr; });
-  const bool freezeNow = friction && !frozen_ && it - bestPass_ >= kFreezeAfterPasses;
+  const auto& frictions = m_.assembly->frictionsPresent();
+  const bool freezeNow = !frictions.empty() && !frozen_ && it - bestPass_ >= kFreezeAfterPasses;
   int local = 0, any = 0;
   for (auto* fr : frictions)
-    if (fr && fr->notePass(mayHold, it - bestPass_ >= kHoldAnyAfterPasses, frozen_ || freezeNow)) local = 1;
+    if (fr->notePass(mayHold, it - bestPass_ >= kHoldAnyAfterPasses, frozen_ || freezeNow)) local = 1;
   Teuchos::reduceAll(*m_.comm, Teuchos::REDUCE_MAX, local, Teuchos::outArg(any));
   if (freezeNow) {
     frozen_ = true, frozenAt_ = it, frozenWorst_.clear();
@@ -227,8 +224,7 @@ bool AugmentationLoop::holdCyclingSlips(int it) {
   }
   if (!any) return false;
   long mine = 0, all = 0;
-  for (auto* fr : m_.assembly->frictions())
-    if (fr) mine += fr->heldPoints();
+  for (auto* fr : frictions) mine += fr->heldPoints();
   Teuchos::reduceAll(*m_.comm, Teuchos::REDUCE_SUM, mine, Teuchos::outArg(all));
   if (log_.on("newton"))
     log_.event("newton", format("pass %d: %ld points held (cycling between stick and slip, or frozen)", it, all),
@@ -548,12 +544,11 @@ NewtonResult AugmentationLoop::polish(double t, double start) {
 
 bool AugmentationLoop::everyPointSlips() {
   auto& assembly = *m_.assembly;
-  const auto& frictions = assembly.frictions();  // one per capstan, null without friction
-  if (std::none_of(frictions.begin(), frictions.end(), [](const auto* f) { return f != nullptr; })) return false;
+  const auto& frictions = assembly.frictionsPresent();
+  if (frictions.empty()) return false;
   assembly.evaluate(*m_.u, nullptr, nullptr);
   long stick = 0, all = 0;
-  for (const auto* f : frictions)
-    if (f) stick += f->figures().stick;
+  for (const auto* f : frictions) stick += f->figures().stick;
   Teuchos::reduceAll(*m_.u->getMap()->getComm(), Teuchos::REDUCE_SUM, stick, Teuchos::outArg(all));
   return all == 0;
 }

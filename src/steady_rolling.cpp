@@ -141,7 +141,7 @@ bool SteadyRolling::steadyStateWithStickRetries(double t, const std::vector<Stea
 
 std::vector<SteadyFrictionEffect*> SteadyRolling::frictionsStartedWide() const {
   std::vector<SteadyFrictionEffect*> widened;
-  for (auto* f : m_.assembly->frictions()) {
+  for (auto* f : m_.assembly->frictionsPresent()) {
     auto* steady = dynamic_cast<SteadyFrictionEffect*>(f);
     if (!steady) continue;
     const double fraction = steady->sceneSlipFraction();
@@ -222,7 +222,7 @@ void SteadyRolling::holdCores(bool hold) {
 }
 
 void SteadyRolling::enableFriction(bool on) {
-  for (auto* f : m_.assembly->frictions())
+  for (auto* f : m_.assembly->frictionsPresent())
     if (auto* steady = dynamic_cast<SteadyFrictionEffect*>(f)) steady->setEnabled(on);
 }
 

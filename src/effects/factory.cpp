@@ -63,6 +63,7 @@ SceneEffects buildEffects(const Mesh& mesh, const Scene& scene) {
     else
       friction = std::make_unique<FrictionEffect>("friction:" + c.name, mesh, quads, contact, c.friction);
     out.frictions.back() = friction.get();
+    out.frictionsPresent.push_back(friction.get());
     out.all.push_back(std::move(friction));
   }
   return out;

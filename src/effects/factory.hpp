@@ -27,6 +27,7 @@ struct SceneEffects {
   BrickEffect* bricks = nullptr;
   std::vector<ContactEffect*> contacts;    // per capstan
   std::vector<FrictionEffect*> frictions;  // per capstan; null without friction
+  std::vector<FrictionEffect*> frictionsPresent;  // the capstans' with friction only, in capstan order
   // The union of all capstans' candidate faces on this rank (4 overlapped node
   // ids each), and per capstan the union index of each of its faces (the
   // contact-face grid of fields.h5).
