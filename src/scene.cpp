@@ -906,12 +906,24 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
                              std::any_of(sc.supports.begin(), sc.supports.end(), [](const SupportSpec& s) {
                                return s.isCore() && s.rotation == SupportSpec::Rotation::Free;
                              });
-  if (turningSteady && sc.solver.linearSolver != SolverSettings::LinearSolver::Direct &&
-      (sc.solver.preconditioner == Prec::MueLu || sc.solver.preconditioner == Prec::Jacobi))
-    v.fail("Solver/Preconditioner", std::string(sc.solver.preconditioner == Prec::MueLu ? "MueLu" : "Jacobi") +
-                                        " cannot precondition steady rolling with a free-turning core: its angular "
-                                        "velocity's row (the torque balance) has no diagonal entry (use Auto or LU, "
-                                        "ILU, or Linear Solver = Direct)");
+  if (turningSteady && (sc.solver.preconditioner == Prec::MueLu || sc.solver.preconditioner == Prec::Jacobi)) {
+    const std::string name = sc.solver.preconditioner == Prec::MueLu ? "MueLu" : "Jacobi";
+    // Linear Solver = Auto solves this mesh directly or not, as Model will
+    // decide it (the nodes' unknowns and 6 per core): directly, the
+    // preconditioner is never built.
+    long dofs = long(3 * nodes);
+    for (const auto& s : sc.supports) dofs += s.isCore() ? 6 : 0;
+    const bool direct = sc.solver.resolved(dofs, sc.mesh.type == MeshSpec::Type::Annulus, friction, true).linearSolver ==
+                        SolverSettings::LinearSolver::Direct;
+    if (!direct)
+      v.fail("Solver/Preconditioner", name +
+                                          " cannot precondition steady rolling with a free-turning core: its angular "
+                                          "velocity's row (the torque balance) has no diagonal entry (use Auto or LU, "
+                                          "ILU, or Linear Solver = Direct)");
+    else if (sc.solver.linearSolver == SolverSettings::LinearSolver::Auto)
+      sc.warnings.push_back(sc.file + ": parameter 'Solver/Preconditioner': " + name +
+                            " is not used: Linear Solver = Auto solves this steady scene directly");
+  }
 
   const auto& out = P.sublist("Output");
   sc.outputDirectory = out.get<std::string>("Directory");

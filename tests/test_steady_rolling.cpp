@@ -183,6 +183,13 @@ TEST(SteadyScene, RejectsWhatItCannotSolve) {
   fails({"Analysis/Start Slip Scales={0.02, 0}"}, "Analysis/Start Slip Scales");
   EXPECT_EQ(steadyScene({"Analysis/Start Slip Scales={0.5}"}).analysis.startSlipScales, std::vector<double>{0.5});
   fails({"Analysis/Type=Steady"}, "Analysis/Type");
+  // MueLu and Jacobi divide by omega's empty diagonal: refused where a Krylov
+  // solve would build them, a warning where Auto solves the mesh directly.
+  fails({"Solver/Linear Solver=GMRES", "Solver/Preconditioner=MueLu"}, "Solver/Preconditioner");
+  fails({"Solver/Preconditioner=Jacobi", "Solver/Direct Solver Max Dofs=100"}, "Solver/Preconditioner");
+  const Scene direct = steadyScene({"Solver/Preconditioner=Jacobi"});
+  ASSERT_EQ(direct.warnings.size(), 1u);
+  EXPECT_NE(direct.warnings[0].find("Jacobi is not used"), std::string::npos) << direct.warnings[0];
 }
 
 // A rolling step (steady or quasi-static, on an annulus) that stalled under
