@@ -20,8 +20,10 @@ void ContactSettings::declare(Teuchos::ParameterList& contact) {
               "off with Gauss rules; 0: off");
   contact.set("Quadrature", std::string("Auto"),
               "Contact points per face: Auto | Gauss 2x2 | Gauss 3x3 | Nodal (at the face's nodes). "
-              "Auto: Gauss 2x2 for Penalty, Nodal for Augmented Lagrangian (exact contact at every "
-              "Gauss point of flat faces on a curved capstan over-constrains the body)");
+              "Auto: Nodal for Augmented Lagrangian (exact contact at every Gauss point of flat faces "
+              "on a curved capstan over-constrains the body), and for a Penalty below 1e-3 h / c "
+              "(h the smallest candidate face edge: Gauss points lock there, and the loops stall); "
+              "Gauss 2x2 for a softer Penalty");
   contact.set("Smoothing", 0.0,
               "Pressure scale eta >= 0 of a smoothed contact law: t_n = (tn + sqrt(tn^2 + eta^2)) / 2 "
               "instead of max(0, tn), at most eta/2 different. Removes the corner where points enter "
@@ -46,6 +48,7 @@ ContactSettings ContactSettings::parse(const Teuchos::ParameterList& ct, const s
                  : rule == Rule::Nodal    ? Quadrature::Nodal
                  : s.exact()              ? Quadrature::Nodal
                                           : Quadrature::Gauss2x2;
+  s.quadratureAuto = rule == Rule::Auto;
   if (s.exact() && s.quadrature != Quadrature::Nodal)
     r.fail(path + "/Quadrature",
            "the Augmented Lagrangian needs Nodal (or Auto): zero gap at every Gauss point of flat "

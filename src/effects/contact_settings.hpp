@@ -23,7 +23,8 @@ struct ContactSettings {
   double penetrationTolerance = 0;  // 0: 1e-4 x the smallest candidate face edge
   double minimumSolvePenalty = 0;   // < 0: automatic (ContactEffect)
   int maxAugmentations = 0;
-  Quadrature quadrature = Quadrature::Gauss2x2;  // Auto resolved by parse()
+  Quadrature quadrature = Quadrature::Gauss2x2;  // Auto resolved by parse(), then for a stiff penalty by ContactEffect
+  bool quadratureAuto = false;                   // the scene left Quadrature at Auto
   double smoothing = 0;             // pressure scale of the smoothed corner; 0: max(0, .)
 
   // Augmented Lagrangian: g = 0 at the points in contact (else g = eps2 t_n).

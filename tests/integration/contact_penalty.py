@@ -65,7 +65,7 @@ if len(errors) == 4:
 print("  penalty, Gauss 2x2:")
 forces = []
 for eps in ("1e-2", "1e-3", "1e-4"):
-    c = final(f"penalty-gauss-{eps}", [f"{C}Method=Penalty", f"{C}Penalty={eps}"])
+    c = final(f"penalty-gauss-{eps}", [f"{C}Method=Penalty", f"{C}Quadrature=Gauss 2x2", f"{C}Penalty={eps}"])
     if c:
         forces.append(c["force"][1])
 if len(forces) == 3:

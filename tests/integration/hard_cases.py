@@ -13,7 +13,9 @@ first order).
   * H5 (mu = 0.9), H4 (k = 0.1) and k = 0.01 (augmented Lagrangian, Coulomb);
   * H1 with Regularization = 1e-15 (an almost discontinuous friction law);
   * H1 with the capstan turning 1 rad per step;
-  * G1 with eps1 = 1e-13 and 1e-1; with eps2 = 1e-14 (augmented Lagrangian);
+  * G1 with eps1 = 1e-13 and 1e-1; with eps2 = 1e-14 (augmented Lagrangian); the plain penalty
+    at eps2 = 1e-12 on G1 and at 2.5e-12 on the Hertz ring (the nodal rule that Quadrature
+    Auto gives so stiff a penalty), against the augmented Lagrangian;
   * G1 indented to 0.8 (46% of the height), G2 and G3 to 0.6;
   * the whole G1 indentation in a single step against 5 steps;
   * the steady 3D drive at mu = 1.2 (its steady state after the Tanh start fails twice and converges with
@@ -70,6 +72,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from capstan_test import Test, has_nan  # noqa: E402
 
 T = Test("hard_cases", __doc__)
+CONTACT = "Capstans/capstan/Contact/"
 FOUND = "Supports/foundation/Stiffness"
 FINE_H = ["Time/Steps=16", "Time/Step Size=0.005"]
 MU12 = "Capstans/capstan/Friction/Coefficient=1.2"
@@ -97,6 +100,14 @@ CASES = [
     ("G1 eps1 = 1e-13", "seed/g1.xml", ["Material/Pressure Penalty=1e-13"], [], 5e-5, 300),
     ("G1 eps1 = 1e-1", "seed/g1.xml", ["Material/Pressure Penalty=1e-1"], [], 5e-5, 300),
     ("G1 eps2 = 1e-14", "seed/g1.xml", ["Capstans/capstan/Contact/Penalty=1e-14"], [], 5e-5, 300),
+    # The plain penalty at eps2 = 1e-12 (Quadrature Auto: the nodal rule, solved at the
+    # automatic floor), against the augmented Lagrangian: with Gauss 2x2 points it stalled
+    # at every cut (docs/contact.md, "Stiff penalties").
+    ("G1 plain penalty eps2 = 1e-12", "seed/g1.xml", [f"{CONTACT}Method=Penalty", f"{CONTACT}Penalty=1e-12"], [],
+     5e-5, 60),
+    # The same on the Hertz ring (a free core pressed by a spring): before, 120 s of cuts.
+    ("Hertz ring plain penalty eps2 = 2.5e-12", "hertz-roller.xml",
+     [f"{CONTACT}Method=Penalty", f"{CONTACT}Penalty=2.5e-12"], [], 5e-5, 40),
     ("G1 to 0.8", "seed/g1.xml", ["Time/Steps=8"], ["Time/Steps=16", "Time/Step Size=0.5"], 5e-5, 400),
     ("G2 to 0.6", "seed/g2.xml", ["Time/Steps=6"], ["Time/Steps=12", "Time/Step Size=0.5"], 5e-5, 600),
     ("G3 to 0.6", "seed/g3.xml", ["Time/Steps=6"], ["Time/Steps=12", "Time/Step Size=0.5"], 5e-5, 400),
