@@ -410,8 +410,8 @@ void Assembly::sumEntityVectors(const std::vector<Matrix>& values) {
   residual_->endAssembly();  // one export: shared rows added into their owners
 }
 
-void Assembly::constraintIncrement(Vector& z, double t0, double t1) const {
-  constraints_.increment(z, t0, t1, cores_);
+void Assembly::constraintIncrement(Vector& z, double t0, double t1, bool turned) const {
+  constraints_.increment(z, t0, t1, cores_, turned);
 }
 
 std::vector<std::array<double, 3>> Assembly::constraintReactions() const {

@@ -76,7 +76,8 @@ class Assembly {
   // Returns false if an element is inverted (det F <= 0 at a Gauss point).
   bool evaluate(const Vector& u, Vector* f, FEMatrix* W, const Vector* z = nullptr, Vector* Kz = nullptr);
   // z = prescribed displacement increment from t0 to t1 (zero on free dofs).
-  void constraintIncrement(Vector& z, double t0, double t1) const;
+  // turned: the cores' prescribed turns already in u (Constraints::increment).
+  void constraintIncrement(Vector& z, double t0, double t1, bool turned = false) const;
 
   // Per-entity vectors of effect e over its dofs (values: entities x dofs,
   // e.g. each brick's d v_e / d x) as sparse rows over the free global dofs of

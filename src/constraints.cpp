@@ -50,7 +50,7 @@ void Constraints::apply(Vector& u, double t, const RigidCores& cores) const {
   }
 }
 
-void Constraints::increment(Vector& z, double t0, double t1, const RigidCores& cores) const {
+void Constraints::increment(Vector& z, double t0, double t1, const RigidCores& cores, bool turned) const {
   auto data = z.getDataNonConst();
   for (LO d = 0; d < LO(data.size()); ++d) {
     const int a = layout_.assemblyDof(d);
@@ -60,7 +60,7 @@ void Constraints::increment(Vector& z, double t0, double t1, const RigidCores& c
       const int i = a % 3;
       const double dT = supportOf[core.firstDof + i] >= 0 ? velocity[core.firstDof + i] * (t1 - t0) : 0.0;
       const int r = core.firstDof + 3;
-      const double dTheta = supportOf[r] >= 0 && !constant[r] ? velocity[r] * (t1 - t0) : 0.0;
+      const double dTheta = supportOf[r] >= 0 && !constant[r] && !turned ? velocity[r] * (t1 - t0) : 0.0;
       data[d] = dT + cores.follower(a / 3).b[i] * dTheta;
     } else {
       data[d] = supportOf[a] >= 0 && !constant[a] ? velocity[a] * (t1 - t0) : 0.0;

@@ -39,7 +39,8 @@ class Constraints {
   void apply(Vector& u, double t, const RigidCores& cores) const;
   // z = prescribed displacement increment from t0 to t1 (zero on free dofs);
   // a core's face nodes linearised at the cores' last state.
-  void increment(Vector& z, double t0, double t1, const RigidCores& cores) const;
+  // turned: the cores' prescribed turns are already in u (Predictors' roll), so left out.
+  void increment(Vector& z, double t0, double t1, const RigidCores& cores, bool turned = false) const;
   // Reaction force of each support on the body: the sum of the owned residual
   // (before constraints) over its held dofs, global (collective).
   std::vector<std::array<double, 3>> reactions(const std::vector<double>& ownedResidual, const Comm& comm) const;

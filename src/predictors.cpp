@@ -42,10 +42,15 @@ double Predictors::firstGuess(double t0, double t, StepRecord& rec) {
   // From the bare state every point of a driven roller's nip slips and the
   // core's rotation has almost no stiffness: turn the body with the core first.
   bool rolled = !continued && rollWithCores(turns);
+  // A free core's roll is the guess. A prescribed turn's roll leaves the
+  // loads' linear response to the tangent predictor, the turn left out of it.
+  const auto& cores = m_.assembly->rigidCores();
+  bool freeRolled = false;
+  for (size_t i = 0; i < cores.size(); ++i) freeRolled = freeRolled || (rolled && cores[i].free[3] && turns[i] != 0);
   // A step that barely changes anything (steady rolling) needs no predictor.
-  if (!continued && !rolled && m_.scene.solver.predictor == SolverSettings::Predictor::Tangent &&
+  if (!continued && !freeRolled && m_.scene.solver.predictor == SolverSettings::Predictor::Tangent &&
       bare > 1e-8 * m_.forceScale)
-    tangent(t0, t, bare, rec);
+    tangent(t0, t, bare, rec, rolled);
   assembly.applyConstraints(*m_.u, t);
   return bare;
 }
@@ -105,7 +110,10 @@ std::vector<double> Predictors::coreTurns(double t0, double t) const {
   const auto& cores = m_.assembly->rigidCores();
   std::vector<double> dTheta;
   for (size_t i = 0; i < cores.size(); ++i) {
-    double omega = 0;
+    // A prescribed rotation turns the body with the core too: from the bare
+    // state only the core's face would turn (9 rad in one step of the Hertz
+    // ring inverted every brick next to it, and no cut recovered).
+    double omega = cores[i].prescribedAngularVelocity;
     if (cores[i].free[3]) {
       if (previous_ && tPrevious_ < t0)
         omega = (cores[i].rotation - previousRotation_[i]) / (t0 - tPrevious_);
@@ -155,11 +163,11 @@ bool Predictors::rollWithCores(const std::vector<double>& dTheta) {
 // Starting Newton from the linear response (rather than with the increment
 // alone on the boundary, where the boundary layer of elements is badly
 // distorted) saves most line-search work.
-void Predictors::tangent(double t0, double t1, double bare, StepRecord& rec) {
+void Predictors::tangent(double t0, double t1, double bare, StepRecord& rec, bool turned) {
   auto& assembly = *m_.assembly;
   const auto map = m_.u->getMap();
   Vector z(map), Kz(map), f(map), rhs(map), du(map);
-  assembly.constraintIncrement(z, t0, t1);
+  assembly.constraintIncrement(z, t0, t1, turned);
   // Into Newton's matrix (Newton reassembles it before it solves): a matrix of
   // the predictor's own would cost memory (docs/performance.md).
   const RCP<FEMatrix> W = m_.newton->matrix();

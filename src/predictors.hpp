@@ -55,7 +55,8 @@ class Predictors {
   bool shiftAlongStreamlines(double t0, double t1, const std::vector<double>& dTheta);
   // K_ff du = -(R + K z)_f from the converged state and the prescribed
   // increment z; kept if it beats the bare increment.
-  void tangent(double t0, double t1, double bare, StepRecord& rec);
+  // turned: the cores' prescribed turns are in u already (rollWithCores).
+  void tangent(double t0, double t1, double bare, StepRecord& rec, bool turned = false);
 
   Model& m_;
   Log& log_;

@@ -21,6 +21,7 @@ RigidCores::RigidCores(const Mesh& mesh, const Scene& scene) : mesh_(mesh), stea
     core.axisPoint = s.axisPoint, core.axisDirection = s.axisDirection, core.force = s.force;
     core.torque = s.torque, core.rampTime = s.rampTime, core.torqueRampTime = s.torqueRampTime;
     core.free = {s.freeTranslation[0], s.freeTranslation[1], s.freeTranslation[2], s.rotation == SupportSpec::Rotation::Free};
+    if (s.rotation == SupportSpec::Rotation::Prescribed) core.prescribedAngularVelocity = s.angularVelocity;
     core.firstDof = nodeDofs + 6 * int(cores_.size());
     for (int n : mesh.faceNodes(s.face))
       if (coreOfNode_[n] < 0) coreOfNode_[n] = int(cores_.size());
@@ -60,7 +61,7 @@ void RigidCores::placeFaceNodes(const Teuchos::ArrayRCP<double>& data) const {
 void RigidCores::roll(const Teuchos::ArrayRCP<double>& data, const std::vector<double>& dTheta) const {
   for (size_t c = 0; c < cores_.size(); ++c) {
     const auto& core = cores_[c];
-    if (!core.free[3] || dTheta[c] == 0) continue;
+    if (dTheta[c] == 0) continue;
     for (size_t n = 0; n < mesh_.numOwnedNodes; ++n) {
       double r[3], turned[3];
       for (int i = 0; i < 3; ++i)

@@ -16,6 +16,7 @@ first order).
   * G1 with eps1 = 1e-13 and 1e-1; with eps2 = 1e-14 (augmented Lagrangian); the plain penalty
     at eps2 = 1e-12 on G1 and at 2.5e-12 on the Hertz ring (the nodal rule that Quadrature
     Auto gives so stiff a penalty), against the augmented Lagrangian;
+  * the Hertz ring's core turned 9.15 rad a step (Rotation = Prescribed), its force on at once;
   * G1 indented to 0.8 (46% of the height), G2 and G3 to 0.6;
   * the whole G1 indentation in a single step against 5 steps;
   * the steady 3D drive at mu = 1.2 (its steady state after the Tanh start fails twice and converges with
@@ -73,6 +74,7 @@ from capstan_test import Test, has_nan  # noqa: E402
 
 T = Test("hard_cases", __doc__)
 CONTACT = "Capstans/capstan/Contact/"
+PRESCRIBED = ["Supports/core/Rotation=Prescribed", "Supports/core/Force Ramp Time=2e-5"]
 FOUND = "Supports/foundation/Stiffness"
 FINE_H = ["Time/Steps=16", "Time/Step Size=0.005"]
 MU12 = "Capstans/capstan/Friction/Coefficient=1.2"
@@ -108,6 +110,11 @@ CASES = [
     # The same on the Hertz ring (a free core pressed by a spring): before, 120 s of cuts.
     ("Hertz ring plain penalty eps2 = 2.5e-12", "hertz-roller.xml",
      [f"{CONTACT}Method=Penalty", f"{CONTACT}Penalty=2.5e-12"], [], 5e-5, 40),
+    # A core turned 9.15 rad (1.5 turns) a step, the force on at once: the predictor turns
+    # the body with the core (before, the bricks at the core inverted and no cut recovered:
+    # 120 s of cuts). Against 8 steps of 2.3 rad to the same angle and force.
+    ("Hertz ring turned 9.15 rad a step", "hertz-roller.xml", PRESCRIBED + ["Supports/core/Angular Velocity=9.14826"],
+     PRESCRIBED + ["Supports/core/Angular Velocity=9.14826", "Time/Steps=8", "Time/Step Size=0.25"], 5e-5, 20),
     ("G1 to 0.8", "seed/g1.xml", ["Time/Steps=8"], ["Time/Steps=16", "Time/Step Size=0.5"], 5e-5, 400),
     ("G2 to 0.6", "seed/g2.xml", ["Time/Steps=6"], ["Time/Steps=12", "Time/Step Size=0.5"], 5e-5, 600),
     ("G3 to 0.6", "seed/g3.xml", ["Time/Steps=6"], ["Time/Steps=12", "Time/Step Size=0.5"], 5e-5, 400),
