@@ -59,6 +59,10 @@ class AugmentationLoop {
   // and the multipliers' move) whether the tolerances are met or not: a
   // starting guess for the next solve (steady rolling's start from rest).
   bool solve(double t, double bare, StepRecord& rec, std::string& failure, int passLimit = 0);
+  // Coulomb: whether a failed solve may go on in pseudo-time while points
+  // stick (LoadStepper: in sub-steps cut a few times; otherwise only where
+  // every point slips, see solvePositions).
+  void allowPseudoTimeWithStick(bool allow) { pseudoTimeWithStick_ = allow; }
 
  private:
   // solve() once, with the step's preconditioner as it stands.
@@ -137,6 +141,7 @@ class AugmentationLoop {
   RegularisationContinuation continuation_;
   std::vector<Kokkos::View<double*>> pressureStepDmu_;  // per effect: its multipliers' change in the step
   bool lastStepShortened_ = false;                     // the last saddle-point step was halved
+  bool pseudoTimeWithStick_ = false;                   // allowPseudoTimeWithStick
 };
 
 }  // namespace capstan
