@@ -20,7 +20,6 @@ using detail::loadEntities;
 // gives a penalty the nodal rule (ContactEffect's constructor).
 constexpr double kGaussPenaltyLimit = 1e-3;
 
-
 static_assert(int(ContactSettings::Quadrature::Gauss2x2) == int(kernels::FaceRule::Gauss2) &&
                   int(ContactSettings::Quadrature::Gauss3x3) == int(kernels::FaceRule::Gauss3) &&
                   int(ContactSettings::Quadrature::Nodal) == int(kernels::FaceRule::Nodal),
@@ -53,7 +52,7 @@ ContactEffect::ContactEffect(const std::string& name, const Mesh& mesh, const st
   tolerance_ = settings.penetrationTolerance > 0 ? settings.penetrationTolerance : 1e-4 * hMin;
   // Auto with a stiff penalty: the nodal rule. Gauss points of flat faces on a
   // curved capstan over-constrain them as eps2 -> 0, and the pressure loop
-  // stalls: G1 at eps2 = 1e-5 took 76 s and 25 cuts, at 1e-6 it failed
+  // stalls: G1 at eps2 = 1e-5 took 75 s and 19 cuts, at 1e-6 it failed
   // (docs/contact.md, "Stiff penalties"); nodal, both in 20 Newton iterations.
   if (settings.quadratureAuto && !settings.exact() && settings.penalty < kGaussPenaltyLimit * hMin / c)
     capstan_.contact.quadrature = ContactSettings::Quadrature::Nodal;
