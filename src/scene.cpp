@@ -21,6 +21,7 @@
 #include <sstream>
 
 #include "errors.hpp"
+#include "log.hpp"
 #include "mesh.hpp"
 #include "parameters.hpp"
 #include "vec3.hpp"
@@ -37,6 +38,9 @@ namespace {
 const char* kAnyName = "<any name>";
 // Sublists passed through to Trilinos unchanged.
 const std::set<std::string> kPassThrough = {"NOX", "Stratimikos", "Belos", "Ifpack2"};
+// The stiffest end of formulation.md's contact penalties, eps2 in [1e-15, 1e-2]:
+// above it, a warning.
+constexpr double kLargestContactPenalty = 1e-2;
 
 Array<double> vec3(double a, double b, double c) { return Teuchos::tuple(a, b, c); }
 
@@ -863,6 +867,14 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
     for (const auto& f : cs.contactFaces)
       if (!faceNames.count(f)) v.fail(path + "/Contact Faces", "'" + f + "' is not a face of the mesh (" + faceText + ")");
     cs.contact = ContactSettings::parse(c.sublist("Contact"), path + "/Contact", v);
+    // Above formulation.md's range the answer (penalty) or the multipliers'
+    // convergence (augmented Lagrangian: a soft solve, the Hertz ring at 0.14
+    // still cutting after 2 minutes against 3 s at 1e-3) suffers; allowed.
+    if (cs.contact.penalty > kLargestContactPenalty)
+      sc.warnings.push_back(sc.file + ": parameter '" + path + "/Contact/Penalty': " +
+                            format("%g", cs.contact.penalty) + " lies above 1e-2, the softest of the range formulation.md gives " +
+                            (cs.contact.exact() ? "(the augmented Lagrangian's multipliers converge slowly from a soft solve)"
+                                                : "(the body sinks into the capstan by about eps2 x the contact pressure)"));
     cs.friction = FrictionSettings::parse(c.sublist("Friction"), path + "/Friction", v);
     if (cs.friction.on() && !cs.friction.grips())  // runs (its kernel reports stick and slip), carries nothing
       sc.warnings.push_back(sc.file + ": parameter '" + path + "/Friction/Coefficient': 0 with Law = " +

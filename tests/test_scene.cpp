@@ -647,6 +647,19 @@ TEST_F(SceneTest, FineSectorCentreModuloATurn) {
   EXPECT_TRUE(c >= -180 && c <= 180) << c;
 }
 
+// A contact penalty softer than formulation.md's range is flagged, the run allowed.
+TEST_F(SceneTest, SoftContactPenaltyWarning) {
+  const std::string g1 = std::string(CAPSTAN_INPUTS_DIR) + "/seed/g1.xml";
+  const std::string P = "Capstans/capstan/Contact/Penalty=";
+  EXPECT_TRUE(loadScene(g1, {P + "1e-2"}, "").warnings.empty());
+  for (const char* method : {"Penalty", "Augmented Lagrangian"}) {
+    const auto soft = loadScene(g1, {P + "0.14", std::string("Capstans/capstan/Contact/Method=") + method}, "");
+    ASSERT_EQ(soft.warnings.size(), 1u) << method;
+    EXPECT_NE(soft.warnings[0].find("Capstans/capstan/Contact/Penalty"), std::string::npos) << soft.warnings[0];
+    EXPECT_NE(soft.warnings[0].find(g1), std::string::npos) << soft.warnings[0];
+  }
+}
+
 // A capstan that can never reach its faces is flagged, conservatively.
 TEST_F(SceneTest, UnreachableCapstanWarning) {
   const std::string g1 = std::string(CAPSTAN_INPUTS_DIR) + "/seed/g1.xml";
