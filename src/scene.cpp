@@ -38,7 +38,7 @@ namespace {
 const char* kAnyName = "<any name>";
 // Sublists passed through to Trilinos unchanged.
 const std::set<std::string> kPassThrough = {"NOX", "Stratimikos", "Belos", "Ifpack2"};
-// The stiffest end of formulation.md's contact penalties, eps2 in [1e-15, 1e-2]:
+// The softest end of formulation.md's contact penalties, eps2 in [1e-15, 1e-2]:
 // above it, a warning.
 constexpr double kLargestContactPenalty = 1e-2;
 
@@ -872,7 +872,8 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
     // still cutting after 2 minutes against 3 s at 1e-3) suffers; allowed.
     if (cs.contact.penalty > kLargestContactPenalty)
       sc.warnings.push_back(sc.file + ": parameter '" + path + "/Contact/Penalty': " +
-                            format("%g", cs.contact.penalty) + " lies above 1e-2, the softest of the range formulation.md gives " +
+                            format("%g lies above %g", cs.contact.penalty, kLargestContactPenalty) +
+                            ", the softest of the range formulation.md gives " +
                             (cs.contact.exact() ? "(the augmented Lagrangian's multipliers converge slowly from a soft solve)"
                                                 : "(the body sinks into the capstan by about eps2 x the contact pressure)"));
     cs.friction = FrictionSettings::parse(c.sublist("Friction"), path + "/Friction", v);
