@@ -41,8 +41,28 @@ const std::set<std::string> kPassThrough = {"NOX", "Stratimikos", "Belos", "Ifpa
 // The softest end of formulation.md's contact penalties, eps2 in [1e-15, 1e-2]:
 // above it, a warning.
 constexpr double kLargestContactPenalty = 1e-2;
+// Tanh and Arctan with a slip speed scale below this fraction of the capstan's
+// surface speed are solved as their limit, Coulomb: there the regularised law
+// holds its sticking points to round-off it cannot resolve (exit 2 on the
+// transient slice from 1e-7, on H5 from 2e-7; docs/friction.md, "Tiny
+// regularisation"), and it lies within about 1e-6 of Coulomb's answer.
+constexpr double kFinestSlipSpeedScale = 3e-7;
 
 Array<double> vec3(double a, double b, double c) { return Teuchos::tuple(a, b, c); }
+
+void solveTinyRegularisationAsCoulomb(CapstanSpec& cs, const std::string& path, Scene& sc) {
+  auto& fr = cs.friction;
+  if (fr.law != FrictionSettings::Law::Tanh && fr.law != FrictionSettings::Law::Arctan) return;
+  const auto& w = cs.velocity;
+  const double speed = std::fabs(cs.angularVelocity) * cs.radius + std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+  if (!(fr.regularization < kFinestSlipSpeedScale * speed)) return;
+  sc.warnings.push_back(sc.file + ": parameter '" + path + "/Friction/Regularization': " +
+                        format("%g lies below %g x the capstan's surface speed (%g)", fr.regularization,
+                               kFinestSlipSpeedScale, speed) +
+                        ", finer than a Newton solve resolves its sticking points: solved as the law's limit, "
+                        "Coulomb (stick and slip), within about 1e-6 of its answer");
+  fr.law = FrictionSettings::Law::Coulomb;
+}
 
 }  // namespace
 
@@ -877,6 +897,7 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
                             (cs.contact.exact() ? "(the augmented Lagrangian's multipliers converge slowly from a soft solve)"
                                                 : "(the body sinks into the capstan by about eps2 x the contact pressure)"));
     cs.friction = FrictionSettings::parse(c.sublist("Friction"), path + "/Friction", v);
+    solveTinyRegularisationAsCoulomb(cs, path, sc);
     if (cs.friction.on() && !cs.friction.grips())  // runs (its kernel reports stick and slip), carries nothing
       sc.warnings.push_back(sc.file + ": parameter '" + path + "/Friction/Coefficient': 0 with Law = " +
                             nameOf(cs.friction.law, FrictionSettings::laws) +

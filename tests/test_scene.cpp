@@ -660,6 +660,28 @@ TEST_F(SceneTest, SoftContactPenaltyWarning) {
   }
 }
 
+// Tanh or Arctan finer than 3e-7 of the capstan's surface speed is solved as
+// Coulomb, with a warning; at the floor and above, and with no speed to compare
+// with, as written.
+TEST_F(SceneTest, TinyRegularisationSolvedAsCoulomb) {
+  const std::string h1 = std::string(CAPSTAN_INPUTS_DIR) + "/seed/h1.xml";  // 12.5 rad/s x R = 2: 25
+  const std::string F = "Capstans/capstan/Friction/";
+  using Law = FrictionSettings::Law;
+  for (const char* law : {"Tanh", "Arctan"}) {
+    const auto tiny = loadScene(h1, {F + "Law=" + law, F + "Regularization=7.4e-6"}, "");
+    EXPECT_EQ(tiny.capstans[0].friction.law, Law::Coulomb) << law;
+    ASSERT_EQ(tiny.warnings.size(), 1u) << law;
+    EXPECT_NE(tiny.warnings[0].find("Capstans/capstan/Friction/Regularization"), std::string::npos) << tiny.warnings[0];
+    EXPECT_NE(tiny.warnings[0].find(h1), std::string::npos) << tiny.warnings[0];
+    const auto kept = loadScene(h1, {F + "Law=" + law, F + "Regularization=7.6e-6"}, "");
+    EXPECT_NE(kept.capstans[0].friction.law, Law::Coulomb) << law;
+    EXPECT_TRUE(kept.warnings.empty()) << law;
+  }
+  // A capstan that neither turns nor moves: no speed to measure the scale against.
+  const auto still = loadScene(h1, {F + "Regularization=1e-15", "Capstans/capstan/Angular Velocity=0"}, "");
+  EXPECT_EQ(still.capstans[0].friction.law, Law::Tanh);
+}
+
 // A capstan that can never reach its faces is flagged, conservatively.
 TEST_F(SceneTest, UnreachableCapstanWarning) {
   const std::string g1 = std::string(CAPSTAN_INPUTS_DIR) + "/seed/g1.xml";

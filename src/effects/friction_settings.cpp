@@ -8,7 +8,9 @@ const std::vector<std::pair<const char*, FrictionSettings::Law>> FrictionSetting
 void FrictionSettings::declare(Teuchos::ParameterList& fr) {
   fr.set("Law", std::string("None"), "None | Tanh | Arctan | Coulomb");
   fr.set("Coefficient", 0.0, "mu >= 0");
-  fr.set("Regularization", 1e-3, "eps3 (Tanh) or eps4 (Arctan) > 0: slip velocity scale");
+  fr.set("Regularization", 1e-3,
+         "eps3 (Tanh) or eps4 (Arctan) > 0: slip velocity scale; below 3e-7 of the capstan's surface "
+         "speed the law is solved as its limit, Coulomb, with a warning (docs/friction.md)");
   fr.set("Tangential Penalty", 0.0,
          "Coulomb: eps_t > 0, tangential slip per unit friction traction while sticking; "
          "0 = the contact's solve penalty");

@@ -35,7 +35,15 @@ to the scene's v, within the increment (no step cut).
     fail at the scene's law and go through the wider laws (the log shows the
     continuation in the loads' steps), with no cut, each step's speed ratio within 2e-5
     of Coulomb's (penetration and stick tolerance 1e-8) and the same stick and slip
-    points.
+    points;
+  * below the floor (a slip speed scale under 3e-7 of the capstan's surface speed:
+    kFinestSlipSpeedScale in src/scene.cpp) the law is solved as its limit, Coulomb,
+    with one warning naming the file and the parameter: the rolling slice under Tanh
+    at 1e-7 of the speed (exit 2 before; 4 steps) within 1e-5 of the same law solved
+    just above the floor (3e-7) in every step's speed ratio; the sweep's steady slice
+    (6x147 cells, pressure penalty 0.06) under Arctan at 2.7e-13 of the speed, on 2
+    ranks (105 s and exit 2 on 1 rank before), within 1e-5 of Arctan at 1e-6, solved as
+    Arctan.
 """
 import os
 import sys
@@ -171,5 +179,41 @@ if out:
     later = {e.get("step") for e in stages(out)}
     T.check(any(step is not None and step > 1 for step in later),
             f"braked slice steady tanh: the continuation ran in the loads' steps (steps {sorted(s for s in later if s)})")
+
+# Below the floor: the law's limit, Coulomb, with a warning.
+SPEED = 19.05 * 2.5  # the slices' capstan surface speed
+FLOOR_WARNING = "Friction/Regularization': "
+
+
+def floor_run(scene_name, tag, law, scale, sets=(), ranks=1):
+    scene = T.input(scene_name)
+    p, s, out = T.run_scene(scene, tag, ranks=ranks,
+                            sets=list(sets) + [F + "Law=" + law, F + f"Regularization={scale * SPEED:.6g}"])
+    warned = p.stderr.count(FLOOR_WARNING) == 1 and scene_name in p.stderr
+    if not (s and s["converged"]):
+        T.check(False, f"{tag}: converged")
+        return None, warned
+    T.conforms(out, scene)
+    T.check(not has_nan(s) and sum(x["cutbacks"] for x in s["steps"]) == 0, f"{tag}: no NaN, no cut")
+    return [x["supports"]["core"]["speed_ratio"] for x in s["steps"]], warned
+
+
+below, warned = floor_run("pinch-roller-slice.xml", "slice tanh 1e-7 of the speed", "Tanh", 1e-7, ["Time/Steps=4"])
+T.check(warned, "slice tanh 1e-7 of the speed: one warning naming the scene and the parameter")
+above, warned_above = floor_run("pinch-roller-slice.xml", "slice tanh 3e-7 of the speed", "Tanh", 3.01e-7,
+                                ["Time/Steps=4"])
+T.check(not warned_above, "slice tanh 3e-7 of the speed: no warning (solved as Tanh)")
+if below and above:
+    d = max(abs(a - b) for a, b in zip(below, above))
+    T.check(d <= 1e-5, f"slice tanh: speed ratios below the floor (as Coulomb) against just above it: {d:.1e} (1e-5)")
+SWEEP = ["Capstans/capstan/Friction/Coefficient=0.591265", "Material/Pressure Penalty=0.0598388",
+         "Mesh/Cells={6, 147, 1}", "Output/Write Fields=false"]
+tiny, warned = floor_run("pinch-roller-slice-steady.xml", "steady slice arctan 2.7e-13, 2 ranks", "Arctan", 2.674e-13,
+                         SWEEP, ranks=2)
+T.check(warned, "steady slice arctan 2.7e-13: one warning naming the scene and the parameter")
+wide, _ = floor_run("pinch-roller-slice-steady.xml", "steady slice arctan 1e-6", "Arctan", 1e-6, SWEEP)
+if tiny and wide:
+    T.check(abs(tiny[0] - wide[0]) <= 1e-5,
+            f"steady slice arctan: speed ratio below the floor {tiny[0]:.7f}, at 1e-6 {wide[0]:.7f} (1e-5)")
 
 T.finish()
