@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "../../kernels/friction.hpp"
 #include "../mesh.hpp"
@@ -44,6 +45,16 @@ FrictionEffect::FrictionEffect(const std::string& name, const Mesh& mesh,
         for (int a = 0; a < 4; ++a)
           for (int i = 0; i < 3; ++i) h(f * kHistoryPerFace + 3 * a + i) = X(f, a, i);
       });
+  {
+    auto Xh = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), X_);
+    const auto& c = contact.capstan();
+    positionScale_ = contact.radius() + std::sqrt(c.axisPoint[0] * c.axisPoint[0] + c.axisPoint[1] * c.axisPoint[1] +
+                                                  c.axisPoint[2] * c.axisPoint[2]);
+    for (size_t f = 0; f < nf; ++f)
+      for (int a = 0; a < 4; ++a)
+        positionScale_ = std::max(positionScale_, std::sqrt(Xh(f, a, 0) * Xh(f, a, 0) + Xh(f, a, 1) * Xh(f, a, 1) +
+                                                            Xh(f, a, 2) * Xh(f, a, 2)));
+  }
   parameters_.law = kernels::FrictionLaw(int(settings.law));
   parameters_.mu = settings.coefficient;
   parameters_.smoothing = settings.smoothing;
@@ -278,6 +289,25 @@ double FrictionEffect::constraintViolation() const {
       },
       Kokkos::Max<double>(v));
   return v;
+}
+
+double FrictionEffect::residualRoundOff(const Teuchos::Comm<int>& comm) const {
+  double sum = 0;
+  if ((settings_.law == FrictionSettings::Law::Tanh || settings_.law == FrictionSettings::Law::Arctan) &&
+      parameters_.v > 0) {
+    auto pts = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), points_);
+    const int nq = kernels::facePointCount(contact_.rule());
+    const double ds = std::numeric_limits<double>::epsilon() * positionScale_;
+    for (size_t f = 0; f < pts.extent(0); ++f)
+      for (int q = 0; q < nq; ++q)
+        if (int(pts(f, q, kState)) != 0) {
+          const double r = pts(f, q, kFWeight) * settings_.coefficient * pts(f, q, kNormal) * ds / parameters_.v;
+          sum += r * r;
+        }
+  }
+  double total = 0;
+  Teuchos::reduceAll(comm, Teuchos::REDUCE_SUM, sum, Teuchos::outArg(total));
+  return std::sqrt(total);
 }
 
 FrictionEffect::Figures FrictionEffect::figures() const {

@@ -32,6 +32,12 @@ class FrictionEffect : public Effect {
   // Tanh and Arctan: the capstan surface's travel over the slip scale v
   // (scale 1), (|omega| R + |velocity|) / eps3, independent of dt; 0 otherwise.
   double travelOverSlipScale() const;
+  // Tanh and Arctan: the residual's round-off floor at the last evaluation,
+  // over all ranks. A slip is known to about eps |x| (positions of size |x|),
+  // and at zero slip the law's slope is mu t_n / v: a law so steep that
+  // w mu t_n eps |x| / v passes Newton's tolerance stalls there (G1 under
+  // Tanh at eps3 = 1e-6: |R| 1e-10 to 1e-9). 0 for the other laws.
+  virtual double residualRoundOff(const Teuchos::Comm<int>& comm) const;
   // Predictor: every contact point sticks (kernels/friction.hpp).
   void setPredicting(bool on) override { parameters_.stickPredictor = on; }
   Kokkos::View<double*> history() override { return history_; }
@@ -146,6 +152,7 @@ class FrictionEffect : public Effect {
   FrictionSettings settings_;
   double dt_ = 0;  // the increment's length (setInterval)
   double regularisationScale_ = 1;
+  double positionScale_ = 0;  // the largest |X| of the faces' nodes and of the capstan's surface
   kernels::FrictionParameters parameters_;
 };
 

@@ -37,6 +37,8 @@ class SteadyFrictionEffect : public FrictionEffect {
   // The multipliers carry over to the next steady state; there is no history.
   void commit(const NodalVectors&) override {}
   bool augmented() const override { return settings_.law == FrictionSettings::Law::Coulomb; }
+  // Its laws solve on their own down to 3e-7 of the capstan's speed (the scene's floor).
+  double residualRoundOff(const Teuchos::Comm<int>&) const override { return 0; }
   bool accelerated() const override { return true; }
   int multiplierSites(std::vector<int>&) const override { return 0; }  // the mesh stands still: no shift
   // Coulomb's sticking points in the saddle-point step, as in the quasi-static

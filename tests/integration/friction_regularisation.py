@@ -43,7 +43,12 @@ to the scene's v, within the increment (no step cut).
     just above the floor (3e-7) in every step's speed ratio; the sweep's steady slice
     (6x147 cells, pressure penalty 0.06) under Arctan at 2.7e-13 of the speed, on 2
     ranks (105 s and exit 2 on 1 rank before), within 1e-5 of Arctan at 1e-6, solved as
-    Arctan.
+    Arctan;
+  * G1 pressed with friction, Tanh at eps3 = 1e-7 (1e-6 of the capstan's approach speed,
+    above the floor): its solves stall at the steep law's round-off, |R| ~ 1e-9, which
+    the later passes now take as their tolerance (FrictionEffect::residualRoundOff;
+    exit 2 before): converges with no cut, the capstan force within 1e-5 of Coulomb's
+    and symmetric about x = 3.5 (F_x below 1e-8 of F_y).
 """
 import os
 import sys
@@ -215,5 +220,19 @@ wide, _ = floor_run("pinch-roller-slice-steady.xml", "steady slice arctan 1e-6",
 if tiny and wide:
     T.check(abs(tiny[0] - wide[0]) <= 1e-5,
             f"steady slice arctan: speed ratio below the floor {tiny[0]:.7f}, at 1e-6 {wide[0]:.7f} (1e-5)")
+
+# G1 under a steep Tanh law, against Coulomb.
+g1 = {}
+for law, extra in (("Tanh", [F + "Regularization=1e-7"]), ("Coulomb", [])):
+    p, s, out = T.run_scene(T.input("seed/g1.xml"), f"g1 {law}", sets=[F + "Law=" + law, F + "Coefficient=0.5"] + extra)
+    if s and s["converged"]:
+        T.conforms(out, os.path.join(out, "scene.xml"))  # the scene as run, with its friction
+        T.check(not has_nan(s) and sum(x["cutbacks"] for x in s["steps"]) == 0, f"g1 {law}: no NaN, no cut")
+        g1[law] = s["steps"][-1]["capstans"]["capstan"]["force"]
+    else:
+        T.check(False, f"g1 {law}: converged")
+if len(g1) == 2:
+    close(g1["Tanh"], g1["Coulomb"], 1e-5, "g1 tanh eps3 = 1e-7: capstan force against Coulomb's")
+    T.check(abs(g1["Tanh"][0]) <= 1e-8 * abs(g1["Tanh"][1]), f"g1 tanh: F_x {g1['Tanh'][0]:.1e} (symmetry)")
 
 T.finish()
