@@ -19,7 +19,11 @@ slice (inputs/pinch-roller-slice-steady.xml, inputs/pinch-roller-braked-steady.x
     4x64 (it is not monotone in between: docs/steady-rolling.md); no continuation step is
     cut, and the speed ratio falls as the brake grows;
   * a brake beyond what the nip can carry (1.5 N mm > mu F R = 1.25) ends with exit 2,
-    the reason in summary.json, and every converged step's nip.csv rows kept.
+    the reason in summary.json, and every converged step's nip.csv rows kept;
+  * the 3D drive on a mesh whose nip spans about one cell (1x43x1, the sweep's case):
+    its multiplier loop freezes stick and slip, and a point held in slip inside the
+    cone dissipates nothing (it reported slip_power -0.017 before): slip_power >= 0 and
+    the output conforms.
 """
 import csv
 import os
@@ -182,5 +186,16 @@ if s:
     T.check(done == [1, 2], f"converged steps kept: {done}")
     steps = {int(r["step"]) for r in nip_rows(out)}
     T.check(steps == set(done), f"nip.csv holds the converged steps {sorted(steps)}")
+
+# -- a nip about one cell wide: frozen states, no negative dissipation ---------------
+drive = T.input("pinch-roller-steady.xml")
+p, s, out = T.run_scene(drive, "coarse-drive", sets=NOFIELDS + ["Mesh/Cells={1, 43, 1}"])
+if s:
+    T.conforms(out, drive)
+    st = s["steps"][-1]
+    T.check(s["converged"] and st["states_frozen"] == 1, f"1x43x1 drive: converged with frozen states "
+            f"({s['converged']}, states_frozen {st['states_frozen']})")
+    T.check(st["capstans"]["capstan"]["slip_power"] >= 0,
+            f"1x43x1 drive: slip_power {st['capstans']['capstan']['slip_power']:.4g} >= 0")
 
 T.finish()
