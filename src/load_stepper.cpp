@@ -17,6 +17,12 @@ constexpr double kMinimumSubstep = 1.0 / 1024;
 // path by about the sub-step. G1 dragged by a turning capstan (mu 0.9-1.6)
 // failed at the smallest sub-step without it (docs/friction.md).
 constexpr double kPseudoTimeWithStickSubstep = 1.0 / 8;
+// Cuts in one step before it fails: a step whose sub-steps fail, pass at half
+// the size, grow and fail again creeps on (the sweep's steady slice with a
+// contact penalty of 2.9, 290x formulation.md's softest, cut 47 times in its
+// first minute at 3.5e-8 of a 3.5e-5 ramp). Ten halvings reach the smallest
+// sub-step; the converging runs in docs/ cut at most 19 times in a whole run.
+constexpr int kMostCutsPerStep = 40;
 
 // How long after t the cores' external loads (forces, torques) still ramp: 0
 // once all are in.
@@ -94,10 +100,12 @@ bool LoadStepper::advance(StepRecord& rec, std::string& failure) {
       chatterHinted_ = true;  // once a run: the hint, before the cuts' retries
       log_.progress("  " + hint.substr(2));
     }
-    if (h < minimumSubstep) {
-      failure = "step " + std::to_string(rec.step) + " failed at minimum step size " +
-                Teuchos::toString(minimumSubstep) + ": " + why + brakeDiagnosis(m_.scene) +
-                stickChatterHint(m_.scene, why);
+    if (h < minimumSubstep || rec.cutbacks > kMostCutsPerStep) {
+      failure = "step " + std::to_string(rec.step) +
+                (h < minimumSubstep ? " failed at minimum step size " + Teuchos::toString(minimumSubstep)
+                                    : format(" failed after %d cuts, %.3g of its %.3g done", rec.cutbacks,
+                                             tDone_ - tStep, rec.time - tStep)) +
+                ": " + why + brakeDiagnosis(m_.scene) + stickChatterHint(m_.scene, why);
       m_.restore(atStep);
       tDone_ = tStep;
       assembly.setInterval(tDone_, tDone_);

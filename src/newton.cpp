@@ -599,6 +599,10 @@ NewtonResult NewtonSolver::solve(Vector& u, double tolerance) {
     r.residualNorm = g.getNormF();
   } catch (const std::exception& e) {
     r.failure = "nonlinear solver error: " + trilinosMessage(e.what());  // less Teuchos' throw details
+    // Belos' CG meets negative curvature: say what that means for the scene.
+    if (std::string(e.what()).find("non-positive value for p^H*A*p") != std::string::npos)
+      r.failure = "the tangent is not positive definite, which Solver/Linear Solver = CG needs (a rolling core, "
+                  "friction or the pressure constraint can make it indefinite): use GMRES or Direct";
   }
   r.failure = impl_->agreement.agree(r.failure);
   auto& out = params->sublist("Direction").sublist("Newton").sublist("Linear Solver").sublist("Output");

@@ -25,6 +25,11 @@ friction for one and crashed with signal 11, on 1 and 2 ranks). (At the
 shipped step of 0.08 the pseudo-time fallback of short sub-steps now rescues
 the step: LoadStepper.)
 
+Case D, CG on the Hertz ring (a free core, rolling from step 2): its tangent is
+not positive definite there, and the failure says so in the scene's words (what CG
+needs, and GMRES or Direct instead), not in Belos' ("non-positive value for
+p^H*A*p").
+
 Checks, every case: exit status 2; summary.json has "converged": false, a
 non-empty "failure", no NaN or infinity anywhere, and passes check_summary.py;
 history.csv, fields.xmf and fields.h5 exist and hold exactly the converged
@@ -148,5 +153,12 @@ sC, outC, fC = common("C-one-friction", ["Capstans/left/Friction/Law=Coulomb", "
                                         "Solver/Max Newton Iterations=2", "Time/Steps=1", "Time/Step Size=15"],
                       min_steps=0, scene_file=T.input("two-capstans.xml"), resolved=True)
 T.check("continuation" in sC["failure"], f"C: the failure is the friction continuation's: {sC['failure']!r}")
+
+# --- Case D: CG on an indefinite tangent -------------------------------------
+print("\n  --- case D: the Hertz ring with Linear Solver = CG")
+sD, outD, fD = common("D-cg", ["Solver/Linear Solver=CG"], min_steps=1, scene_file=T.input("hertz-roller.xml"),
+                      resolved=True)
+T.check("not positive definite" in sD["failure"] and "GMRES" in sD["failure"] and "p^H" not in sD["failure"],
+        f"D: the failure names what CG needs: {sD['failure']!r}")
 
 T.finish()
