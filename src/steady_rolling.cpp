@@ -1,5 +1,6 @@
 #include "steady_rolling.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -166,6 +167,9 @@ bool SteadyRolling::startThroughWideLaws(double t, const std::vector<SteadyFrict
   holdCores(false);
   bool ok = true;
   std::vector<double> scales = startSlipScales(widened);
+  // Coulomb starts through Tanh; Tanh and Arctan through themselves, wider
+  // (asked before the first stage turns Coulomb's effects into Tanh).
+  const bool coulomb = std::any_of(widened.begin(), widened.end(), [](auto* f) { return f->augmented(); });
   int refinements = 0;
   for (int k = 0; k < int(scales.size()); ++k) {
     const double scale = scales[k];
@@ -177,7 +181,8 @@ bool SteadyRolling::startThroughWideLaws(double t, const std::vector<SteadyFrict
     }
     if (wider == 0) break;
     const auto before = m_.snapshot();
-    const std::string stage = format("start: slip speed scale %g x the capstan's (Tanh in Coulomb's place)", scale);
+    const std::string stage = format("start: slip speed scale %g x the capstan's (%s)", scale,
+                                     coulomb ? "Tanh in Coulomb's place" : "the scene's law, wider");
     ok = solveStage(t, stage.c_str(), rec, failure, kGuessPasses);
     if (ok) continue;
     if (refinements == kStageRefinements) break;
