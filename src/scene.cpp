@@ -53,8 +53,7 @@ Array<double> vec3(double a, double b, double c) { return Teuchos::tuple(a, b, c
 void solveTinyRegularisationAsCoulomb(CapstanSpec& cs, const std::string& path, Scene& sc) {
   auto& fr = cs.friction;
   if (fr.law != FrictionSettings::Law::Tanh && fr.law != FrictionSettings::Law::Arctan) return;
-  const auto& w = cs.velocity;
-  const double speed = std::fabs(cs.angularVelocity) * cs.radius + std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+  const double speed = cs.surfaceSpeed();
   if (!(fr.regularization < kFinestSlipSpeedScale * speed)) return;
   sc.warnings.push_back(sc.file + ": parameter '" + path + "/Friction/Regularization': " +
                         format("%g lies below %g x the capstan's surface speed (%g)", fr.regularization,

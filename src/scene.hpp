@@ -5,6 +5,7 @@
 #include <Teuchos_ParameterList.hpp>
 
 #include <array>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,11 @@ struct CapstanSpec {
   std::vector<std::string> contactFaces;
   ContactSettings contact;
   FrictionSettings friction;
+  // How fast its surface travels: |omega| R + |velocity|.
+  double surfaceSpeed() const {
+    return std::fabs(angularVelocity) * radius +
+           std::sqrt(velocity[0] * velocity[0] + velocity[1] * velocity[1] + velocity[2] * velocity[2]);
+  }
 };
 
 struct Scene {

@@ -79,10 +79,7 @@ void FrictionEffect::setRegularisationScale(double scale) {
 
 double FrictionEffect::travelOverSlipScale() const {
   if (settings_.law != FrictionSettings::Law::Tanh && settings_.law != FrictionSettings::Law::Arctan) return 0;
-  const auto& c = contact_.capstan();
-  const double speed = std::sqrt(c.velocity[0] * c.velocity[0] + c.velocity[1] * c.velocity[1] +
-                                 c.velocity[2] * c.velocity[2]);
-  return (std::fabs(c.angularVelocity) * contact_.radius() + speed) / settings_.regularization;
+  return contact_.capstan().surfaceSpeed() / settings_.regularization;
 }
 
 void FrictionEffect::launch(const NodalVectors& x, const NodalVectors&, bool tangent, const TangentSink& sink) {
