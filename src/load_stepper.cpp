@@ -21,7 +21,8 @@ constexpr double kPseudoTimeWithStickSubstep = 1.0 / 8;
 // the size, grow and fail again creeps on (the sweep's steady slice with a
 // contact penalty of 2.9, 290x formulation.md's softest, cut 47 times in its
 // first minute at 3.5e-8 of a 3.5e-5 ramp). Ten halvings reach the smallest
-// sub-step; the converging runs in docs/ cut at most 19 times in a whole run.
+// sub-step; today's converging runs in docs/ cut at most 19 times in a whole run
+// (H4 once needed 37 in its step 2, before the pseudo-time fallback).
 constexpr int kMostCutsPerStep = 40;
 
 // How long after t the cores' external loads (forces, torques) still ramp: 0
