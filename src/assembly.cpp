@@ -47,7 +47,7 @@ void Assembly::buildGraph() {
     auto h = perRow.view_host();
     Kokkos::deep_copy(h, size_t(81 + extraColumns_ + 4 * cores_.size()));
     for (size_t c = 0; c < cores_.size(); ++c)
-      for (int j = 0; j < 6; ++j) h(layout_.overlapLid(cores_.records()[c].firstDof + j)) = cores_.rowEntries(c);
+      for (int j = 0; j < kCoreUnknowns; ++j) h(layout_.overlapLid(cores_.records()[c].firstDof + j)) = cores_.rowEntries(c);
     perRow.modify_host();
     perRow.sync_device();
     graph_ = rcp(new FEGraph(ownedDofMap_, overlapDofMap_, perRow, importer_));
@@ -81,7 +81,7 @@ void Assembly::buildGraph() {
   }
   if (layout_.coresOwned)  // the cores' held dofs get their unit diagonal
     for (const auto& core : cores_.records())
-      for (int j = 0; j < 6; ++j) {
+      for (int j = 0; j < kCoreUnknowns; ++j) {
         const GO g = gid(core.firstDof + j);
         graph_->insertGlobalIndices(g, Teuchos::ArrayView<const GO>(&g, 1));
       }

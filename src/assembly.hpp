@@ -37,7 +37,7 @@ class Assembly {
   RigidCores& cores() { return cores_; }
   // Local id in dofMap() of a rigid core's dof j (0..5) on rank 0, -1 elsewhere.
   LO ownedCoreDof(size_t core, int j) const {
-    return layout_.coresOwned ? LO(3 * mesh_.numOwnedNodes + 6 * core + j) : -1;
+    return layout_.coresOwned ? LO(3 * mesh_.numOwnedNodes + kCoreUnknowns * core + j) : -1;
   }
   RCP<FEMatrix> createMatrix() const;
   const Constraints& constraints() const { return constraints_; }

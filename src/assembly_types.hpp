@@ -8,6 +8,7 @@
 #include <Tpetra_Vector.hpp>
 
 #include "mesh.hpp"
+#include "support_settings.hpp"
 
 namespace capstan {
 
@@ -16,9 +17,8 @@ using CrsMatrix = Tpetra::CrsMatrix<>;
 using FEMatrix = Tpetra::FECrsMatrix<>;
 using FEGraph = Tpetra::FECrsGraph<>;
 
-// "Assembly dofs": 3 * overlapped node + component, then 6 per rigid core (Tx
-// Ty Tz theta and two unused slots, so the dofs stay in blocks of 3). The
-// cores' dofs are global, owned by rank 0.
+// "Assembly dofs": 3 * overlapped node + component, then kCoreUnknowns per
+// rigid core. The cores' dofs are global, owned by rank 0.
 struct DofLayout {
   int nodeDofs = 0;          // 3 x overlapped nodes: the first core dof
   int ownedNodeDofs = 0;     // 3 x owned nodes
@@ -29,13 +29,13 @@ struct DofLayout {
   DofLayout(const Mesh& mesh, size_t numCores)
       : nodeDofs(int(3 * mesh.numOverlapNodes())), ownedNodeDofs(int(3 * mesh.numOwnedNodes)), cores(int(numCores)),
         coresOwned(numCores > 0 && mesh.comm->getRank() == 0) {}
-  int size() const { return nodeDofs + 6 * cores; }
+  int size() const { return nodeDofs + kCoreUnknowns * cores; }
   // Assembly dofs <-> local ids of the Tpetra maps. Overlapped order: owned
   // node dofs, (rank 0) the cores' dofs, ghost node dofs, (other ranks) the
   // cores' dofs: Tpetra's finite-element objects need the owned ids first.
   LO overlapLid(int dof) const {
     if (dof >= nodeDofs) return LO(coresOwned ? ownedNodeDofs + (dof - nodeDofs) : dof);
-    return LO(coresOwned && dof >= ownedNodeDofs ? dof + 6 * cores : dof);
+    return LO(coresOwned && dof >= ownedNodeDofs ? dof + kCoreUnknowns * cores : dof);
   }
   int assemblyDof(LO ownedLid) const {
     return ownedLid < LO(ownedNodeDofs) ? int(ownedLid) : nodeDofs + int(ownedLid - LO(ownedNodeDofs));

@@ -23,7 +23,7 @@ Constraints::Constraints(const Mesh& mesh, const Scene& scene, RigidCores& cores
       for (size_t n = 0; n < mesh.numOverlapNodes(); ++n)
         if (cores.coreOf(n) == c)
           for (int i = 0; i < 3; ++i) supportOf[3 * n + i] = id;
-      for (int j = 0; j < 6; ++j) {
+      for (int j = 0; j < kCoreUnknowns; ++j) {
         if (j < 4 && core.free[j]) continue;  // an unknown of the Newton solve
         supportOf[core.firstDof + j] = id;
         velocity[core.firstDof + j] = j == 3 && s.rotation == SupportSpec::Rotation::Prescribed ? s.angularVelocity : 0.0;

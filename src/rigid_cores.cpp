@@ -22,7 +22,7 @@ RigidCores::RigidCores(const Mesh& mesh, const Scene& scene) : mesh_(mesh), stea
     core.torque = s.torque, core.rampTime = s.rampTime, core.torqueRampTime = s.torqueRampTime;
     core.free = {s.freeTranslation[0], s.freeTranslation[1], s.freeTranslation[2], s.rotation == SupportSpec::Rotation::Free};
     if (s.rotation == SupportSpec::Rotation::Prescribed) core.prescribedAngularVelocity = s.angularVelocity;
-    core.firstDof = nodeDofs + 6 * int(cores_.size());
+    core.firstDof = nodeDofs + kCoreUnknowns * int(cores_.size());
     for (int n : mesh.faceNodes(s.face))
       if (coreOfNode_[n] < 0) coreOfNode_[n] = int(cores_.size());
     cores_.push_back(core);
@@ -69,7 +69,7 @@ void RigidCores::roll(const Teuchos::ArrayRCP<double>& data, const std::vector<d
       kernels::rotateAboutAxis(core.axisDirection.data(), dTheta[c], r, turned);
       for (int i = 0; i < 3; ++i) data[3 * n + i] += turned[i] - r[i];
     }
-    if (layout_.coresOwned) data[3 * mesh_.numOwnedNodes + 6 * c + 3] += dTheta[c];
+    if (layout_.coresOwned) data[3 * mesh_.numOwnedNodes + kCoreUnknowns * c + 3] += dTheta[c];
   }
 }
 
@@ -122,7 +122,7 @@ void RigidCores::findCoupling(const std::vector<std::unique_ptr<Effect>>& effect
     }
   }
   for (size_t c = 0; c < cores_.size(); ++c)
-    rowEntries_[c] = std::count(seen[c].begin(), seen[c].end(), char(1)) + 6 * cores_.size();
+    rowEntries_[c] = std::count(seen[c].begin(), seen[c].end(), char(1)) + kCoreUnknowns * cores_.size();
 }
 
 void RigidCores::assembleCoupling(FEMatrix& W, const std::vector<std::unique_ptr<Effect>>& effects,

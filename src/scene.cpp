@@ -930,33 +930,32 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
       v.fail("Solver/Linear Solver", "CG needs a symmetric matrix; friction on capstan '" + c.name +
                                          "' makes it non-symmetric (use Auto, GMRES or Direct)");
 
+  // Which linear solver the run will use, Auto resolved as Model will (the
+  // nodes' unknowns and the cores'): a direct solve builds no preconditioner.
+  using Prec = SolverSettings::Preconditioner;
+  using Lin = SolverSettings::LinearSolver;
+  long dofs = long(3 * nodes);
+  for (const auto& s : sc.supports) dofs += s.isCore() ? kCoreUnknowns : 0;
+  const bool direct = sc.solver.resolved(dofs, sc.mesh.type == MeshSpec::Type::Annulus, friction,
+                                         sc.analysis.steady()).linearSolver == Lin::Direct;
+  const std::string precName = nameOf(sc.solver.preconditioner, SolverSettings::preconditioners);
   // Steady rolling makes a free core's rotation unknown its angular velocity,
   // which moves no node: the torque balance's row has no diagonal entry, and
   // MueLu's smoothed aggregation and Jacobi divide by the diagonal (MueLu: "Prolongator
   // damping factor needs to be finite").
-  using Prec = SolverSettings::Preconditioner;
   const bool turningSteady = sc.analysis.steady() &&
                              std::any_of(sc.supports.begin(), sc.supports.end(), [](const SupportSpec& s) {
                                return s.isCore() && s.rotation == SupportSpec::Rotation::Free;
                              });
-  if (turningSteady && (sc.solver.preconditioner == Prec::MueLu || sc.solver.preconditioner == Prec::Jacobi)) {
-    const std::string name = sc.solver.preconditioner == Prec::MueLu ? "MueLu" : "Jacobi";
-    // Linear Solver = Auto solves this mesh directly or not, as Model will
-    // decide it (the nodes' unknowns and 6 per core): directly, the
-    // preconditioner is never built.
-    long dofs = long(3 * nodes);
-    for (const auto& s : sc.supports) dofs += s.isCore() ? 6 : 0;
-    const bool direct = sc.solver.resolved(dofs, sc.mesh.type == MeshSpec::Type::Annulus, friction, true).linearSolver ==
-                        SolverSettings::LinearSolver::Direct;
-    if (!direct)
-      v.fail("Solver/Preconditioner", name +
-                                          " cannot precondition steady rolling with a free-turning core: its angular "
-                                          "velocity's row (the torque balance) has no diagonal entry (use Auto or LU, "
-                                          "ILU, or Linear Solver = Direct)");
-    else if (sc.solver.linearSolver == SolverSettings::LinearSolver::Auto)
-      sc.warnings.push_back(sc.file + ": parameter 'Solver/Preconditioner': " + name +
-                            " is not used: Linear Solver = Auto solves this steady scene directly");
-  }
+  if (turningSteady && !direct && (sc.solver.preconditioner == Prec::MueLu || sc.solver.preconditioner == Prec::Jacobi))
+    v.fail("Solver/Preconditioner", precName +
+                                        " cannot precondition steady rolling with a free-turning core: its angular "
+                                        "velocity's row (the torque balance) has no diagonal entry (use Auto or LU, "
+                                        "ILU, or Linear Solver = Direct)");
+  if (direct && sc.solver.preconditioner != Prec::Auto && sc.solver.preconditioner != Prec::None)
+    sc.warnings.push_back(sc.file + ": parameter 'Solver/Preconditioner': " + precName + " is not used: " +
+                          (sc.solver.linearSolver == Lin::Auto ? "Linear Solver = Auto solves this scene directly"
+                                                               : "Linear Solver = Direct factorises the matrix"));
 
   const auto& out = P.sublist("Output");
   sc.outputDirectory = out.get<std::string>("Directory");

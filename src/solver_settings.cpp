@@ -34,6 +34,9 @@ using S = SolverSettings;
 
 const std::vector<std::pair<const char*, S::LinearSolver>> S::linearSolvers = {
     {"Auto", LinearSolver::Auto}, {"GMRES", LinearSolver::GMRES}, {"CG", LinearSolver::CG}, {"Direct", LinearSolver::Direct}};
+const std::vector<std::pair<const char*, S::Preconditioner>> S::preconditioners = {
+    {"Auto", Preconditioner::Auto}, {"ILU", Preconditioner::ILU}, {"Jacobi", Preconditioner::Jacobi},
+    {"MueLu", Preconditioner::MueLu}, {"LU", Preconditioner::LU}, {"None", Preconditioner::None}};
 const std::vector<std::pair<const char*, S::LineSearch>> S::lineSearches = {
     {"Backtrack", LineSearch::Backtrack}, {"Polynomial", LineSearch::Polynomial}, {"Full Step", LineSearch::FullStep}};
 
@@ -49,7 +52,7 @@ void SolverSettings::declare(ParameterList& sol) {
           "Auto | ILU | Jacobi | MueLu | LU | None (Ifpack2 RILUK per rank, Jacobi relaxation; MueLu smoothed "
           "aggregation with the rigid-body modes; LU: a MUMPS factorisation kept across Newton iterations "
           "while it works, see Preconditioner Reuse). Auto: LU in steady rolling, else MueLu from 1000 dofs, ILU "
-          "below");
+          "below. A direct linear solve builds none (a named one is a warning)");
   sol.set("ILU Level", 1, "ILU: level of fill (>= 0)");
   sol.set("Preconditioner Reuse", std::string("Adaptive"),
           "Adaptive | None. Adaptive: Newton builds its preconditioner at each load step's start "
@@ -135,11 +138,7 @@ SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterRe
   s.linearSolver = r.choice(sol, at, "Linear Solver", linearSolvers);
   s.unsymmetric = friction || steady;
   s.directSolverMaxDofs = r.atLeast(sol, at, "Direct Solver Max Dofs", 0);
-  s.preconditioner = r.choice(sol, at, "Preconditioner",
-                              std::vector<std::pair<const char*, Preconditioner>>{
-                                  {"Auto", Preconditioner::Auto}, {"ILU", Preconditioner::ILU},
-                                  {"Jacobi", Preconditioner::Jacobi}, {"MueLu", Preconditioner::MueLu},
-                                  {"LU", Preconditioner::LU}, {"None", Preconditioner::None}});
+  s.preconditioner = r.choice(sol, at, "Preconditioner", preconditioners);
   s.iluLevel = r.atLeast(sol, at, "ILU Level", 0);
   s.preconditionerReuse = r.choice(sol, at, "Preconditioner Reuse",
                                    std::vector<std::pair<const char*, Reuse>>{{"Adaptive", Reuse::Adaptive},

@@ -97,6 +97,7 @@ struct SolverSettings {
   static SolverSettings defaults(bool friction = false, bool rolling = false, bool steady = false);
 
   static const std::vector<std::pair<const char*, LinearSolver>> linearSolvers;
+  static const std::vector<std::pair<const char*, Preconditioner>> preconditioners;
   static const std::vector<std::pair<const char*, LineSearch>> lineSearches;
 };
 

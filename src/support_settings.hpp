@@ -16,6 +16,10 @@
 
 namespace capstan {
 
+// The unknowns a rigid core adds to the system: Tx Ty Tz, theta, and two
+// unused slots so that the unknowns stay in blocks of 3 (DofLayout).
+constexpr int kCoreUnknowns = 6;
+
 struct SupportSpec {
   enum class Type { Fixed, Roller, Foundation, Displacement, RigidCore };
   enum class Rotation { Fixed, Free, Prescribed };  // of a rigid core about its axis

@@ -682,6 +682,28 @@ TEST_F(SceneTest, TinyRegularisationSolvedAsCoulomb) {
   EXPECT_EQ(still.capstans[0].friction.law, Law::Tanh);
 }
 
+// A named preconditioner that a direct solve never builds is a warning
+// naming the file and the parameter; one a Krylov solve builds is not.
+TEST_F(SceneTest, PreconditionerUnusedByDirectSolve) {
+  const std::string g1 = std::string(CAPSTAN_INPUTS_DIR) + "/seed/g1.xml";
+  const auto direct = loadScene(g1, {"Solver/Linear Solver=Direct", "Solver/Preconditioner=ILU"}, "");
+  ASSERT_EQ(direct.warnings.size(), 1u);
+  EXPECT_NE(direct.warnings[0].find(g1 + ": parameter 'Solver/Preconditioner': ILU is not used: Linear Solver = Direct"),
+            std::string::npos)
+      << direct.warnings[0];
+  EXPECT_TRUE(loadScene(g1, {"Solver/Linear Solver=Direct", "Solver/Preconditioner=None"}, "").warnings.empty());
+  EXPECT_TRUE(loadScene(g1, {"Solver/Linear Solver=GMRES", "Solver/Preconditioner=ILU"}, "").warnings.empty());
+  // Auto solves G1 (1,575 unknowns, frictionless) by GMRES with the LU
+  // preconditioner: a named one replaces it. With friction Auto is direct.
+  EXPECT_TRUE(loadScene(g1, {"Solver/Preconditioner=MueLu"}, "").warnings.empty());
+  const std::string h1 = std::string(CAPSTAN_INPUTS_DIR) + "/seed/h1.xml";
+  const auto autoDirect = loadScene(h1, {"Solver/Preconditioner=MueLu"}, "");
+  ASSERT_EQ(autoDirect.warnings.size(), 1u);
+  EXPECT_NE(autoDirect.warnings[0].find("MueLu is not used: Linear Solver = Auto solves this scene directly"),
+            std::string::npos)
+      << autoDirect.warnings[0];
+}
+
 // A capstan that can never reach its faces is flagged, conservatively.
 TEST_F(SceneTest, UnreachableCapstanWarning) {
   const std::string g1 = std::string(CAPSTAN_INPUTS_DIR) + "/seed/g1.xml";
