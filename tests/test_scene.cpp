@@ -595,11 +595,20 @@ TEST_F(SceneTest, CapstanOfG1) {
   EXPECT_EQ(c.velocity, (std::array<double, 3>{0, -0.1, 0}));
   EXPECT_EQ(c.contactFaces, (std::vector<std::string>{"ymax"}));
   EXPECT_EQ(c.contact.method, ContactSettings::Method::AugmentedLagrangian);
-  EXPECT_EQ(c.contact.quadrature, ContactSettings::Quadrature::Nodal) << "Auto: the augmented Lagrangian uses the nodal rule";
+  EXPECT_EQ(c.contact.quadrature, ContactSettings::Quadrature::Auto);
+  EXPECT_EQ(c.contact.resolvedQuadrature(0.5, 1.0), ContactSettings::Quadrature::Nodal)
+      << "Auto: the augmented Lagrangian uses the nodal rule";
   EXPECT_LT(c.contact.minimumSolvePenalty, 0) << "automatic solve penalty by default";
   const Scene p = loadScene(std::string(CAPSTAN_INPUTS_DIR) + "/seed/g1.xml",
                             {"Capstans/capstan/Contact/Method=Penalty"}, "");
-  EXPECT_EQ(p.capstans[0].contact.quadrature, ContactSettings::Quadrature::Gauss2x2) << "Auto: the penalty method uses Gauss 2x2";
+  // G1's penalty 1e-3 against 1e-3 h / c: Gauss 2x2 for h / c below 1, nodal above.
+  EXPECT_EQ(p.capstans[0].contact.resolvedQuadrature(0.99, 1.0), ContactSettings::Quadrature::Gauss2x2)
+      << "Auto: the penalty method uses Gauss 2x2";
+  EXPECT_EQ(p.capstans[0].contact.resolvedQuadrature(1.01, 1.0), ContactSettings::Quadrature::Nodal)
+      << "Auto: a stiff penalty uses the nodal rule";
+  const Scene named = loadScene(std::string(CAPSTAN_INPUTS_DIR) + "/seed/g1.xml",
+                                {"Capstans/capstan/Contact/Method=Penalty", "Capstans/capstan/Contact/Quadrature=Gauss 3x3"}, "");
+  EXPECT_EQ(named.capstans[0].contact.resolvedQuadrature(0.01, 1.0), ContactSettings::Quadrature::Gauss3x3);
 }
 
 TEST_F(SceneTest, CapstanInputErrors) {

@@ -16,10 +16,6 @@ namespace capstan {
 using detail::dofsOf;
 using detail::loadEntities;
 
-// Below this times h / c (h the smallest candidate face edge), Quadrature Auto
-// gives a penalty the nodal rule (ContactEffect's constructor).
-constexpr double kGaussPenaltyLimit = 1e-3;
-
 static_assert(int(ContactSettings::Quadrature::Gauss2x2) == int(kernels::FaceRule::Gauss2) &&
                   int(ContactSettings::Quadrature::Gauss3x3) == int(kernels::FaceRule::Gauss3) &&
                   int(ContactSettings::Quadrature::Nodal) == int(kernels::FaceRule::Nodal),
@@ -50,12 +46,7 @@ ContactEffect::ContactEffect(const std::string& name, const Mesh& mesh, const st
   double hMin = h;
   Teuchos::reduceAll(*mesh.comm, Teuchos::REDUCE_MIN, h, Teuchos::outArg(hMin));
   tolerance_ = settings.penetrationTolerance > 0 ? settings.penetrationTolerance : 1e-4 * hMin;
-  // Auto with a stiff penalty: the nodal rule. Gauss points of flat faces on a
-  // curved capstan over-constrain them as eps2 -> 0, and the pressure loop
-  // stalls: G1 at eps2 = 1e-5 took 75 s and 19 cuts, at 1e-6 it failed
-  // (docs/contact.md, "Stiff penalties"); nodal, both in 20 Newton iterations.
-  if (settings.quadratureAuto && !settings.exact() && settings.penalty < kGaussPenaltyLimit * hMin / c)
-    capstan_.contact.quadrature = ContactSettings::Quadrature::Nodal;
+  capstan_.contact.quadrature = settings.resolvedQuadrature(hMin, c);
   // Automatic floor for the nodal rule only: with Gauss points the penalty
   // answer approaches an over-constrained one as eps2 -> 0 (flat faces cannot
   // touch a curved capstan at every Gauss point), and the multiplier loop

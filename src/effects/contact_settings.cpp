@@ -37,25 +37,27 @@ ContactSettings ContactSettings::parse(const Teuchos::ParameterList& ct, const s
   s.penalty = r.positive(ct, path, "Penalty");
   s.penetrationTolerance = r.nonNegative(ct, path, "Penetration Tolerance");
   s.minimumSolvePenalty = r.finite(ct, path, "Minimum Solve Penalty");
-  enum class Rule { Auto, Gauss2x2, Gauss3x3, Nodal };
-  const Rule rule = r.choice(ct, path, "Quadrature",
-                             std::vector<std::pair<const char*, Rule>>{{"Auto", Rule::Auto},
-                                                                       {"Gauss 2x2", Rule::Gauss2x2},
-                                                                       {"Gauss 3x3", Rule::Gauss3x3},
-                                                                       {"Nodal", Rule::Nodal}});
-  s.quadrature = rule == Rule::Gauss2x2   ? Quadrature::Gauss2x2
-                 : rule == Rule::Gauss3x3 ? Quadrature::Gauss3x3
-                 : rule == Rule::Nodal    ? Quadrature::Nodal
-                 : s.exact()              ? Quadrature::Nodal
-                                          : Quadrature::Gauss2x2;
-  s.quadratureAuto = rule == Rule::Auto;
-  if (s.exact() && s.quadrature != Quadrature::Nodal)
+  s.quadrature = r.choice(ct, path, "Quadrature",
+                          std::vector<std::pair<const char*, Quadrature>>{{"Auto", Quadrature::Auto},
+                                                                          {"Gauss 2x2", Quadrature::Gauss2x2},
+                                                                          {"Gauss 3x3", Quadrature::Gauss3x3},
+                                                                          {"Nodal", Quadrature::Nodal}});
+  if (s.exact() && s.quadrature != Quadrature::Nodal && s.quadrature != Quadrature::Auto)
     r.fail(path + "/Quadrature",
            "the Augmented Lagrangian needs Nodal (or Auto): zero gap at every Gauss point of flat "
            "faces against a curved capstan is impossible, and the multipliers would never settle");
   s.smoothing = r.nonNegative(ct, path, "Smoothing");
   s.maxAugmentations = r.atLeast(ct, path, "Max Augmentations", 1);
   return s;
+}
+
+// A stiff penalty gets the nodal rule: Gauss points of flat faces on a curved
+// capstan over-constrain them as eps2 -> 0, and the pressure loop stalls: G1 at
+// eps2 = 1e-5 took 75 s and 19 cuts, at 1e-6 it failed (docs/contact.md, "Stiff
+// penalties"); nodal, both in 20 Newton iterations.
+ContactSettings::Quadrature ContactSettings::resolvedQuadrature(double hMin, double c) const {
+  if (quadrature != Quadrature::Auto) return quadrature;
+  return exact() || penalty < kGaussPenaltyLimit * hMin / c ? Quadrature::Nodal : Quadrature::Gauss2x2;
 }
 
 }  // namespace capstan

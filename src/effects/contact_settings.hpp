@@ -1,7 +1,7 @@
 // A capstan's Contact sublist, typed: declared (name, default, doc string) and
 // parsed side by side, the only place its defaults are stated. ContactEffect
-// reads it as it is; what depends on the mesh (the automatic tolerance and
-// solve penalty) is resolved there.
+// reads it as it is; what depends on the mesh (the automatic tolerance, solve
+// penalty and quadrature) is resolved there, the quadrature's rule here.
 #pragma once
 
 #include <Teuchos_ParameterList.hpp>
@@ -15,20 +15,26 @@ namespace capstan {
 
 struct ContactSettings {
   enum class Method { Penalty, AugmentedLagrangian };
-  // Values are kernels::FaceRule's (checked in contact.cpp).
-  enum class Quadrature { Gauss2x2 = 0, Gauss3x3 = 1, Nodal = 2 };
+  // Values are kernels::FaceRule's (checked in contact.cpp); Auto is resolved
+  // by resolvedQuadrature() once the faces are known.
+  enum class Quadrature { Gauss2x2 = 0, Gauss3x3 = 1, Nodal = 2, Auto = 3 };
+  // Below this times h / c (h the smallest candidate face edge, c the shear
+  // modulus), Quadrature Auto gives a penalty the nodal rule.
+  static constexpr double kGaussPenaltyLimit = 1e-3;
 
   Method method = Method::Penalty;
   double penalty = 0;               // eps2: penetration per unit contact pressure
   double penetrationTolerance = 0;  // 0: 1e-4 x the smallest candidate face edge
   double minimumSolvePenalty = 0;   // < 0: automatic (ContactEffect)
   int maxAugmentations = 0;
-  Quadrature quadrature = Quadrature::Gauss2x2;  // Auto resolved by parse(), then for a stiff penalty by ContactEffect
-  bool quadratureAuto = false;                   // the scene left Quadrature at Auto
+  Quadrature quadrature = Quadrature::Auto;  // as the scene names it (ContactEffect resolves Auto)
   double smoothing = 0;             // pressure scale of the smoothed corner; 0: max(0, .)
 
   // Augmented Lagrangian: g = 0 at the points in contact (else g = eps2 t_n).
   bool exact() const { return method == Method::AugmentedLagrangian; }
+  // The rule the contact points follow, Auto resolved: Nodal for the augmented
+  // Lagrangian and for a Penalty below kGaussPenaltyLimit hMin / c, else Gauss 2x2.
+  Quadrature resolvedQuadrature(double hMin, double c) const;
 
   static void declare(Teuchos::ParameterList& contact);
   static ContactSettings parse(const Teuchos::ParameterList& contact, const std::string& path,
