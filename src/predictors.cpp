@@ -113,7 +113,8 @@ std::vector<double> Predictors::coreTurns(double t0, double t) const {
     // A prescribed rotation turns the body with the core too: from the bare
     // state only the core's face would turn (9 rad in one step of the Hertz
     // ring inverted every brick next to it, and no cut recovered).
-    double omega = cores[i].prescribedAngularVelocity;
+    // (Constraints' velocity of theta: the prescribed omega, or 0 for a held core.)
+    double omega = m_.assembly->constraints().velocity[cores[i].firstDof + 3];
     if (cores[i].free[3]) {
       if (previous_ && tPrevious_ < t0)
         omega = (cores[i].rotation - previousRotation_[i]) / (t0 - tPrevious_);

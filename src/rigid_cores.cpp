@@ -21,7 +21,6 @@ RigidCores::RigidCores(const Mesh& mesh, const Scene& scene) : mesh_(mesh), stea
     core.axisPoint = s.axisPoint, core.axisDirection = s.axisDirection, core.force = s.force;
     core.torque = s.torque, core.rampTime = s.rampTime, core.torqueRampTime = s.torqueRampTime;
     core.free = {s.freeTranslation[0], s.freeTranslation[1], s.freeTranslation[2], s.rotation == SupportSpec::Rotation::Free};
-    if (s.rotation == SupportSpec::Rotation::Prescribed) core.prescribedAngularVelocity = s.angularVelocity;
     core.firstDof = nodeDofs + kCoreUnknowns * int(cores_.size());
     for (int n : mesh.faceNodes(s.face))
       if (coreOfNode_[n] < 0) coreOfNode_[n] = int(cores_.size());

@@ -35,7 +35,6 @@ struct RigidCore {
   std::array<double, 3> axisPoint{}, axisDirection{}, force{};
   double torque = 0, rampTime = 1, torqueRampTime = 1;
   std::array<bool, 4> free{};  // Tx Ty Tz theta
-  double prescribedAngularVelocity = 0;  // Rotation = Prescribed: theta = this x t (0 otherwise)
   int support = -1;            // its support id in Constraints
   int firstDof = 0;            // assembly dof of Tx
   // At the last evaluation (global): q, and the force and torque of the core
