@@ -47,9 +47,6 @@ FrictionEffect::FrictionEffect(const std::string& name, const Mesh& mesh,
       });
   {
     auto Xh = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), X_);
-    const auto& c = contact.capstan();
-    positionScale_ = contact.radius() + std::sqrt(c.axisPoint[0] * c.axisPoint[0] + c.axisPoint[1] * c.axisPoint[1] +
-                                                  c.axisPoint[2] * c.axisPoint[2]);
     for (size_t f = 0; f < nf; ++f)
       for (int a = 0; a < 4; ++a)
         positionScale_ = std::max(positionScale_, std::sqrt(Xh(f, a, 0) * Xh(f, a, 0) + Xh(f, a, 1) * Xh(f, a, 1) +
@@ -294,7 +291,11 @@ double FrictionEffect::residualRoundOff(const Teuchos::Comm<int>& comm) const {
       parameters_.v > 0) {
     auto pts = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), points_);
     const int nq = kernels::facePointCount(contact_.rule());
-    const double ds = std::numeric_limits<double>::epsilon() * positionScale_;
+    // Positions reach the faces' farthest node or the capstan's surface now
+    // (a capstan with a Velocity moves away from where it started).
+    const auto cyl = contact_.cylinder();
+    const double capstanReach = cyl.R + std::sqrt(cyl.a[0] * cyl.a[0] + cyl.a[1] * cyl.a[1] + cyl.a[2] * cyl.a[2]);
+    const double ds = std::numeric_limits<double>::epsilon() * std::max(positionScale_, capstanReach);
     for (size_t f = 0; f < pts.extent(0); ++f)
       for (int q = 0; q < nq; ++q)
         if (int(pts(f, q, kState)) != 0) {

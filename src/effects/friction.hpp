@@ -152,7 +152,7 @@ class FrictionEffect : public Effect {
   FrictionSettings settings_;
   double dt_ = 0;  // the increment's length (setInterval)
   double regularisationScale_ = 1;
-  double positionScale_ = 0;  // the largest |X| of the faces' nodes and of the capstan's surface
+  double positionScale_ = 0;  // the largest |X| of the faces' nodes
   kernels::FrictionParameters parameters_;
 };
 
