@@ -246,6 +246,10 @@ struct NewtonSolver::Impl {
       lsp.sublist("Backtrack").set("Max Iters", 20);
       lsp.sublist("Backtrack").set("Recovery Step", 0.0);
     }
+    // Polynomial alike: its recovery step of 1 took H4 under Tanh (mu 1.87,
+    // GMRES) from |R| 18 into an inverted state, whose next solve was NaN.
+    if (solver.lineSearch == SolverSettings::LineSearch::Polynomial)
+      lsp.sublist("Polynomial").set("Recovery Step", 0.0);
     auto& newton = params->sublist("Direction").sublist("Newton");
     newton.sublist("Linear Solver").set("Tolerance", solver.linearTolerance);
     // Eisenstat-Walker (NOX's Type 2): far from the solution a Krylov solve to

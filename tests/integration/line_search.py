@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
-"""The Newton line search (src/newton.cpp): a failed backtracking line search
-takes no step ("Recovery Step" 0) instead of NOX's default, the full Newton step.
+"""The Newton line search (src/newton.cpp): a failed backtracking or polynomial
+line search takes no step ("Recovery Step" 0) instead of NOX's default, the full
+Newton step.
 
 Each case runs with capstan's setting and with NOX's default restored through the
 scene's Solver/NOX sublist (Line Search/Backtrack/Recovery Step = 1):
@@ -15,6 +16,10 @@ scene's Solver/NOX sublist (Line Search/Backtrack/Recovery Step = 1):
   * H5 and the stick-slip scene: the same per-step capstan forces (1e-9
     relative) in fewer Newton iterations (at round-off a line search cannot
     decrease |R|; the recovery step then wandered until Stagnation stopped it).
+  * Line Search = Polynomial on H4 under Tanh (mu 1.87, Regularization 5.65) with
+    GMRES (a randomized sweep's case): NOX's recovery step of 1 went from |R| 18 into
+    an inverted state, every cut back then ended on Belos' NaN residual, exit 2;
+    with capstan's setting it converges (exit 0), no cut back by NaN.
 """
 import os
 import re
@@ -91,4 +96,15 @@ for scene in ("seed/h5.xml", "seed/stick-slip.xml"):
     # pressure passes were solved to 1e-6; solved to 1e-4 they stop before
     # round-off, and the two now tie. Capstan's setting must never cost more.
     T.check(na <= nb, f"{scene}: {na} Newton iterations, no more than {nb} with NOX's default recovery step")
+
+# --- the polynomial line search -----------------------------------------------------
+F = "Capstans/capstan/Friction/"
+POLY = [F + "Law=Tanh", F + "Coefficient=1.87134", F + "Regularization=5.65272", "Solver/Linear Solver=GMRES",
+        "Solver/Line Search=Polynomial"]
+p, s, out = T.run_scene(T.input("seed/h4.xml"), "h4-polynomial", sets=POLY, quiet=False)
+reasons = re.findall(r"cut back to dt = \S+ \((.*)", p.stdout)
+nan = [r for r in reasons if "NaN" in r or r.startswith("nonlinear solver error")]
+T.check(s is not None and s["converged"] and not nan,
+        f"H4, Tanh mu 1.87, Polynomial line search: converged {s is not None and s['converged']}, "
+        f"{len(reasons)} cut backs, {len(nan)} by NaN or a solver exception")
 T.finish()
