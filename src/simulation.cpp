@@ -26,6 +26,7 @@ class Simulation {
     Model::checkRanks(scene_, *comm_);
     if (!options_.restart.empty()) restart_ = std::make_unique<Restart>(scene_, *comm_, options_.restart);
     model_ = std::make_unique<Model>(scene_, comm_);
+    warnOfMeshDependentSettings();
     outputs_ = std::make_unique<Outputs>(*model_, log_, start_);
     if (restart_) restart_->restore(*model_, steps_, outputs_->earlier);
     openOutputs();
@@ -50,6 +51,17 @@ class Simulation {
   }
 
  private:
+  // What the scene's settings mean on its mesh, known once the mesh is built
+  // (the scene's own warnings come from loadScene).
+  void warnOfMeshDependentSettings() const {
+    if (!model_->rank0) return;
+    const auto& contacts = model_->assembly->contacts();
+    for (size_t i = 0; i < contacts.size(); ++i)
+      if (!contacts[i]->quadratureWarning().empty())
+        std::fprintf(stderr, "capstan: WARNING: %s: parameter 'Capstans/%s/Contact/Quadrature': %s\n",
+                     scene_.file.c_str(), contacts[i]->capstan().name.c_str(), contacts[i]->quadratureWarning().c_str());
+  }
+
   // The output directory, the files a restart continues, the initial state.
   void openOutputs() {
     outputs_->checkDirectory();

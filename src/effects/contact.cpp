@@ -8,6 +8,7 @@
 #include "../../kernels/contact.hpp"
 #include "../mesh.hpp"
 #include "entities.hpp"
+#include "../log.hpp"
 #include "../step_record.hpp"
 #include "../vec3.hpp"
 
@@ -47,6 +48,17 @@ ContactEffect::ContactEffect(const std::string& name, const Mesh& mesh, const st
   Teuchos::reduceAll(*mesh.comm, Teuchos::REDUCE_MIN, h, Teuchos::outArg(hMin));
   tolerance_ = settings.penetrationTolerance > 0 ? settings.penetrationTolerance : 1e-4 * hMin;
   capstan_.contact.quadrature = settings.resolvedQuadrature(hMin, c);
+  using Q = ContactSettings::Quadrature;
+  ContactSettings asAuto = settings;
+  asAuto.quadrature = Q::Auto;
+  if ((settings.quadrature == Q::Gauss2x2 || settings.quadrature == Q::Gauss3x3) &&
+      asAuto.resolvedQuadrature(hMin, c) == Q::Nodal)
+    quadratureWarning_ = format("Gauss %s with Penalty %g, below %g h / c = %g (h = %g, the shortest contact face "
+                                "edge): Gauss points of flat faces lock against the curved capstan and the loops "
+                                "stall (docs/contact.md, \"Stiff penalties\"); Auto gives this penalty Nodal",
+                                settings.quadrature == Q::Gauss2x2 ? "2x2" : "3x3", settings.penalty,
+                                ContactSettings::kGaussPenaltyLimit, ContactSettings::kGaussPenaltyLimit * hMin / c,
+                                hMin);
   // Automatic floor for the nodal rule only: with Gauss points the penalty
   // answer approaches an over-constrained one as eps2 -> 0 (flat faces cannot
   // touch a curved capstan at every Gauss point), and the multiplier loop

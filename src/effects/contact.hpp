@@ -25,6 +25,9 @@ class ContactEffect : public Effect {
   // or a penalty solved at a larger penalty than the scene's.
   bool augmented() const { return compliance_ < solvePenalty_; }
   double solvePenalty() const { return solvePenalty_; }
+  // A Gauss rule the scene names with a Penalty that Auto would give the nodal
+  // rule: what the run warns of (empty otherwise).
+  const std::string& quadratureWarning() const { return quadratureWarning_; }
   Kokkos::View<double*> multipliers() override {
     return augmented() ? lambda_ : Kokkos::View<double*>();
   }
@@ -94,6 +97,7 @@ class ContactEffect : public Effect {
   double tolerance_ = 0;          // on eps |t_n - lambda| (length), resolved against the mesh
   std::array<double, 3> beta_{};  // unit axis direction
   double time_ = 0;
+  std::string quadratureWarning_;
   bool predicting_ = false;
   double solvePenalty_ = 1e-3;  // eps of the Newton solves
   double compliance_ = 1e-3;    // kappa: g = kappa t_n at the fixed point (0: exact contact)

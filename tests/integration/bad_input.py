@@ -20,7 +20,10 @@ fields.h5 whole.
 
 Then the warning for a capstan that can never touch its contact faces: printed
 (naming the file and the capstan), the run goes on and exits 0; no warning for
-G1, nor for a capstan that starts far away but moves into the body.
+G1, nor for a capstan that starts far away but moves into the body. And the
+warning for a Gauss rule named with a penalty stiffer than 1e-3 h / c (Auto
+would give it the nodal rule): G1 at Penalty 3e-4 (h / c = 0.5) is warned, with
+the file, the parameter and the threshold, and runs; at 5e-4 it is not.
 """
 import os
 import subprocess
@@ -296,6 +299,16 @@ for label, text in (("G1", G1),
     T.check(p.returncode == 0 and "WARNING" not in p.stderr,
             f"no warning for {label}: exit {p.returncode}, stderr {p.stderr.strip()[:200]!r}")
 T.check(listing(work) == {}, "validate writes nothing")
+# --- a Gauss rule with a penalty stiff enough to lock it: warning, the run goes on ---------
+for penalty, warned in (("3e-4", True), ("5e-4", False)):
+    p, s, _ = T.run_scene(T.input("seed/g1.xml"), f"gauss-{penalty}",
+                          sets=["Capstans/capstan/Contact/Method=Penalty", f"Capstans/capstan/Contact/Penalty={penalty}",
+                                "Capstans/capstan/Contact/Quadrature=Gauss 2x2", "Time/Steps=1"])
+    err = p.stderr.strip()
+    says = ("WARNING" in err and T.input("seed/g1.xml") in err and "Capstans/capstan/Contact/Quadrature" in err
+            and "0.001 h / c = 0.0005" in err)
+    T.check(says == warned and ("WARNING" in err) == warned and s is not None and s["converged"],
+            f"Gauss 2x2 at Penalty {penalty}: {'a' if warned else 'no'} warning, converged: {err[:300]!r}")
 # --- rigid cores: singular set-ups and misplaced parameters (on the roller slice) ----
 SLICE = T.input("pinch-roller-slice.xml")
 
