@@ -1,5 +1,7 @@
 #include "bricks.hpp"
 
+#include <Teuchos_CommHelpers.hpp>
+
 #include "../../kernels/brick.hpp"
 #include "../mesh.hpp"
 #include "entities.hpp"
@@ -68,6 +70,34 @@ void BrickEffect::launch(const NodalVectors& x, const NodalVectors&, bool tangen
         v(e) = st.volume;
         minJ(e) = st.minJ;
       });
+}
+
+BrickEffect::Compression BrickEffect::mostCompressed(const Teuchos::Comm<int>& comm) const {
+  using MinLoc = Kokkos::MinLoc<double, int>;
+  typename MinLoc::value_type local;
+  auto minJ = minJacobian;
+  Kokkos::parallel_reduce(
+      "brick most compressed", Kokkos::RangePolicy<ExecSpace>(0, minJ.extent(0)),
+      KOKKOS_LAMBDA(int e, typename MinLoc::value_type& m) {
+        if (minJ(e) < m.val) m.val = minJ(e), m.loc = e;
+      },
+      MinLoc(local));
+  Compression c;
+  const bool any = minJ.extent(0) > 0;
+  const double mine = any ? local.val : 1e300;
+  Teuchos::reduceAll(comm, Teuchos::REDUCE_MIN, mine, Teuchos::outArg(c.detF));
+  // The centroid from the rank that holds the smallest (the lowest such rank).
+  const int holder = any && mine == c.detF ? comm.getRank() : comm.getSize();
+  int first = holder;
+  Teuchos::reduceAll(comm, Teuchos::REDUCE_MIN, holder, Teuchos::outArg(first));
+  std::array<double, 3> at{};
+  if (first == comm.getRank()) {
+    auto X = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), Kokkos::subview(X_, local.loc, Kokkos::ALL, Kokkos::ALL));
+    for (int a = 0; a < 8; ++a)
+      for (int i = 0; i < 3; ++i) at[i] += X(a, i) / 8;
+  }
+  Teuchos::reduceAll(comm, Teuchos::REDUCE_SUM, 3, at.data(), c.centroid.data());
+  return c;
 }
 
 void BrickEffect::volumeGradients(const NodalVectors& x, Matrix& g) const {

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <array>
+
 #include "effect.hpp"
 
 namespace capstan {
@@ -16,6 +18,13 @@ class BrickEffect : public Effect {
   // Element Cauchy stress (xx yy zz xy yz xz) and von Mises at the centroids.
   void centroidStress(const NodalVectors& x, Matrix& stress, Kokkos::View<double*>& mises) const;
   double c() const { return c_; }
+  // The smallest Gauss-point det F of the last evaluation over all ranks, and
+  // where its element's reference centroid lies: how near the mesh is to folding.
+  struct Compression {
+    double detF = 1;
+    std::array<double, 3> centroid{};
+  };
+  Compression mostCompressed(const Teuchos::Comm<int>& comm) const;
   // The penalty eps of the Newton solves (the scene's eps1, raised to
   // Solver/Minimum Solve Penalty).
   double solvePenalty() const { return penalty_; }

@@ -30,6 +30,12 @@ not positive definite there, and the failure says so in the scene's words (what 
 needs, and GMRES or Direct instead), not in Belos' ("non-positive value for
 p^H*A*p").
 
+Case E, G1 pressed 0.1 a step for 11 steps: step 9 (0.9 of the 1.75 high block)
+converges, step 10 cannot. The failure says where the last converged mesh is most
+distorted: det F 0.48 at a Gauss point of the element around (4.25, 1.53, 1) or its
+mirror image at z = 3 (formulation.md's G1 is symmetric about z = 2). Cases A-D are
+not distorted (det F above 0.5 everywhere), and their failures say nothing of it.
+
 Checks, every case: exit status 2; summary.json has "converged": false, a
 non-empty "failure", no NaN or infinity anywhere, and passes check_summary.py;
 history.csv, fields.xmf and fields.h5 exist and hold exactly the converged
@@ -160,5 +166,17 @@ sD, outD, fD = common("D-cg", ["Solver/Linear Solver=CG"], min_steps=1, scene_fi
                       resolved=True)
 T.check("not positive definite" in sD["failure"] and "GMRES" in sD["failure"] and "p^H" not in sD["failure"],
         f"D: the failure names what CG needs: {sD['failure']!r}")
+
+
+# --- Case E: pressed beyond what its mesh follows ---------------------------------
+print("\n  --- case E: G1 pressed to 1.1 in 11 steps")
+sE, outE, fE = common("E-deep", ["Time/Steps=11"], min_steps=9, scene_file=T.input("seed/g1.xml"), resolved=True)
+m = re.search(r"det F = ([0-9.e+-]+), in the element around \(([^)]*)\)", sE["failure"])
+at = [float(x) for x in m.group(2).split(",")] if m else []
+T.check(m is not None and abs(float(m.group(1)) - 0.48) < 0.01 and len(at) == 3
+        and abs(at[0] - 4.25) < 1e-9 and abs(at[1] - 1.53125) < 1e-3 and min(abs(at[2] - 1), abs(at[2] - 3)) < 1e-9,
+        f"E: the failure names the most distorted element: {sE['failure']!r}")
+for label, sx in (("A", sA), ("B", sB), ("C", sC), ("D", sD)):
+    T.check("det F" not in sx["failure"], f"{label}: no distortion note: {sx['failure']!r}")
 
 T.finish()
