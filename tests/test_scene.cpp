@@ -606,6 +606,8 @@ TEST_F(SceneTest, CapstanOfG1) {
       << "Auto: the penalty method uses Gauss 2x2";
   EXPECT_EQ(p.capstans[0].contact.resolvedQuadrature(1.01, 1.0), ContactSettings::Quadrature::Nodal)
       << "Auto: a stiff penalty uses the nodal rule";
+  EXPECT_EQ(p.capstans[0].contact.resolvedQuadrature(0.99, 1.0, true), ContactSettings::Quadrature::Nodal)
+      << "Auto: exact stick (steady Coulomb) uses the nodal rule";
   const Scene named = loadScene(std::string(CAPSTAN_INPUTS_DIR) + "/seed/g1.xml",
                                 {"Capstans/capstan/Contact/Method=Penalty", "Capstans/capstan/Contact/Quadrature=Gauss 3x3"}, "");
   EXPECT_EQ(named.capstans[0].contact.resolvedQuadrature(0.01, 1.0), ContactSettings::Quadrature::Gauss3x3);

@@ -23,7 +23,7 @@ static_assert(int(ContactSettings::Quadrature::Gauss2x2) == int(kernels::FaceRul
               "ContactSettings::Quadrature names kernels::FaceRule's values");
 
 ContactEffect::ContactEffect(const std::string& name, const Mesh& mesh, const std::vector<int>& quads,
-                             const CapstanSpec& capstan, double c)
+                             const CapstanSpec& capstan, double c, bool exactStick)
     : Effect(name), capstan_(capstan) {
   const ContactSettings& settings = capstan.contact;
   const size_t nf = quads.size() / 4;
@@ -47,12 +47,12 @@ ContactEffect::ContactEffect(const std::string& name, const Mesh& mesh, const st
   double hMin = h;
   Teuchos::reduceAll(*mesh.comm, Teuchos::REDUCE_MIN, h, Teuchos::outArg(hMin));
   tolerance_ = settings.penetrationTolerance > 0 ? settings.penetrationTolerance : 1e-4 * hMin;
-  capstan_.contact.quadrature = settings.resolvedQuadrature(hMin, c);
+  capstan_.contact.quadrature = settings.resolvedQuadrature(hMin, c, exactStick);
   using Q = ContactSettings::Quadrature;
   ContactSettings asAuto = settings;
   asAuto.quadrature = Q::Auto;
   if ((settings.quadrature == Q::Gauss2x2 || settings.quadrature == Q::Gauss3x3) &&
-      asAuto.resolvedQuadrature(hMin, c) == Q::Nodal)
+      asAuto.resolvedQuadrature(hMin, c) == Q::Nodal)  // (the stiff penalty's reason)
     quadratureWarning_ = format("Gauss %s with Penalty %g, below %g h / c = %g (h = %g, the shortest contact face "
                                 "edge): Gauss points of flat faces lock against the curved capstan and the loops "
                                 "stall (docs/contact.md, \"Stiff penalties\"); Auto gives this penalty Nodal",

@@ -17,8 +17,9 @@ namespace capstan {
 class ContactEffect : public Effect {
  public:
   // `c`: the body's material constant (the automatic solve penalty).
+  // `exactStick`: the friction on these faces sticks exactly (steady Coulomb).
   ContactEffect(const std::string& name, const Mesh& mesh, const std::vector<int>& quads,
-                const CapstanSpec& capstan, double c);
+                const CapstanSpec& capstan, double c, bool exactStick = false);
 
   void setInterval(double tStart, double tEnd) override;
   // Multipliers only where they change the answer: the augmented Lagrangian,

@@ -22,7 +22,8 @@ void ContactSettings::declare(Teuchos::ParameterList& contact) {
               "Contact points per face: Auto | Gauss 2x2 | Gauss 3x3 | Nodal (at the face's nodes). "
               "Auto: Nodal for Augmented Lagrangian (exact contact at every Gauss point of flat faces "
               "on a curved capstan over-constrains the body), and for a Penalty below 1e-3 h / c "
-              "(h the smallest candidate face edge: Gauss points lock there, and the loops stall); "
+              "(h the smallest candidate face edge: Gauss points lock there, and the loops stall), "
+              "and in steady rolling under Coulomb (its exact stick needs one point per node); "
               "Gauss 2x2 for a softer Penalty");
   contact.set("Smoothing", 0.0,
               "Pressure scale eta >= 0 of a smoothed contact law: t_n = (tn + sqrt(tn^2 + eta^2)) / 2 "
@@ -55,9 +56,12 @@ ContactSettings ContactSettings::parse(const Teuchos::ParameterList& ct, const s
 // capstan over-constrain them as eps2 -> 0, and the pressure loop stalls: G1 at
 // eps2 = 1e-5 took 75 s and 19 cuts, at 1e-6 it failed (docs/contact.md, "Stiff
 // penalties"); nodal, both in 20 Newton iterations.
-ContactSettings::Quadrature ContactSettings::resolvedQuadrature(double hMin, double c) const {
+// Exact stick with Gauss points has no stick rows in the saddle-point step,
+// and the multiplier loop crawls: the steady slice under Coulomb with a contact
+// Penalty of 1e-2 failed (6e-3: 85 Newton iterations); nodal, 13 (0.066: 11).
+ContactSettings::Quadrature ContactSettings::resolvedQuadrature(double hMin, double c, bool exactStick) const {
   if (quadrature != Quadrature::Auto) return quadrature;
-  return exact() || penalty < kGaussPenaltyLimit * hMin / c ? Quadrature::Nodal : Quadrature::Gauss2x2;
+  return exact() || exactStick || penalty < kGaussPenaltyLimit * hMin / c ? Quadrature::Nodal : Quadrature::Gauss2x2;
 }
 
 }  // namespace capstan

@@ -33,8 +33,10 @@ struct ContactSettings {
   // Augmented Lagrangian: g = 0 at the points in contact (else g = eps2 t_n).
   bool exact() const { return method == Method::AugmentedLagrangian; }
   // The rule the contact points follow, Auto resolved: Nodal for the augmented
-  // Lagrangian and for a Penalty below kGaussPenaltyLimit hMin / c, else Gauss 2x2.
-  Quadrature resolvedQuadrature(double hMin, double c) const;
+  // Lagrangian, for a Penalty below kGaussPenaltyLimit hMin / c, and where the
+  // friction on these faces sticks exactly (exactStick: steady Coulomb, whose
+  // stick rows sit at the nodal rule's points); else Gauss 2x2.
+  Quadrature resolvedQuadrature(double hMin, double c, bool exactStick = false) const;
 
   static void declare(Teuchos::ParameterList& contact);
   static ContactSettings parse(const Teuchos::ParameterList& contact, const std::string& path,

@@ -51,7 +51,8 @@ SceneEffects buildEffects(const Mesh& mesh, const Scene& scene) {
         out.contactFaceOf.back().push_back(it->second);
       }
     }
-    auto effect = std::make_unique<ContactEffect>("contact:" + c.name, mesh, quads, c, scene.c);
+    const bool exactStick = scene.analysis.steady() && c.friction.law == FrictionSettings::Law::Coulomb;
+    auto effect = std::make_unique<ContactEffect>("contact:" + c.name, mesh, quads, c, scene.c, exactStick);
     out.contacts.push_back(effect.get());
     out.frictions.push_back(nullptr);
     const ContactEffect& contact = *effect;

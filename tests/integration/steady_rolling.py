@@ -23,7 +23,11 @@ slice (inputs/pinch-roller-slice-steady.xml, inputs/pinch-roller-braked-steady.x
   * the 3D drive on a mesh whose nip spans about one cell (1x43x1, the sweep's case):
     its multiplier loop freezes stick and slip, and a point held in slip inside the
     cone dissipates nothing (it reported slip_power -0.017 before): slip_power >= 0 and
-    the output conforms.
+    the output conforms;
+  * penalty contact under Coulomb (Contact/Method = Penalty at 1e-2, and 0.066, which
+    the run warns about): Quadrature Auto gives exact stick the nodal rule, whose stick
+    rows the saddle-point step takes; with Gauss 2x2 the loop crawled (6e-3: 85 Newton
+    iterations) or failed (1e-2). Each converges in at most 20 Newton iterations.
 """
 import csv
 import os
@@ -197,5 +201,14 @@ if s:
             f"({s['converged']}, states_frozen {st['states_frozen']})")
     T.check(st["capstans"]["capstan"]["slip_power"] >= 0,
             f"1x43x1 drive: slip_power {st['capstans']['capstan']['slip_power']:.4g} >= 0")
+
+# -- penalty contact: exact stick on the nodal rule -----------------------------------
+for penalty in ("1e-2", "0.066"):
+    p, s, out = T.run_scene(free, f"penalty-{penalty}", sets=NOFIELDS + ["Capstans/capstan/Contact/Method=Penalty",
+                                                                       f"Capstans/capstan/Contact/Penalty={penalty}"])
+    if s:
+        T.conforms(out, os.path.join(out, "scene.xml"))
+        n = sum(st["newton_iterations"] for st in s["steps"])
+        T.check(s["converged"] and n <= 20, f"Penalty {penalty}: converged {s['converged']} in {n} Newton iterations (<= 20)")
 
 T.finish()
