@@ -48,17 +48,24 @@ ContactEffect::ContactEffect(const std::string& name, const Mesh& mesh, const st
   Teuchos::reduceAll(*mesh.comm, Teuchos::REDUCE_MIN, h, Teuchos::outArg(hMin));
   tolerance_ = settings.penetrationTolerance > 0 ? settings.penetrationTolerance : 1e-4 * hMin;
   capstan_.contact.quadrature = settings.resolvedQuadrature(hMin, c, exactStick);
+  // A Gauss rule the scene names where Auto would take the nodal one.
   using Q = ContactSettings::Quadrature;
-  ContactSettings asAuto = settings;
-  asAuto.quadrature = Q::Auto;
-  if ((settings.quadrature == Q::Gauss2x2 || settings.quadrature == Q::Gauss3x3) &&
-      asAuto.resolvedQuadrature(hMin, c) == Q::Nodal)  // (the stiff penalty's reason)
-    quadratureWarning_ = format("Gauss %s with Penalty %g, below %g h / c = %g (h = %g, the shortest contact face "
-                                "edge): Gauss points of flat faces lock against the curved capstan and the loops "
-                                "stall (docs/contact.md, \"Stiff penalties\"); Auto gives this penalty Nodal",
-                                settings.quadrature == Q::Gauss2x2 ? "2x2" : "3x3", settings.penalty,
-                                ContactSettings::kGaussPenaltyLimit, ContactSettings::kGaussPenaltyLimit * hMin / c,
-                                hMin);
+  if (settings.quadrature == Q::Gauss2x2 || settings.quadrature == Q::Gauss3x3) {
+    const char* gauss = settings.quadrature == Q::Gauss2x2 ? "2x2" : "3x3";
+    ContactSettings asAuto = settings;
+    asAuto.quadrature = Q::Auto;
+    if (asAuto.resolvedQuadrature(hMin, c) == Q::Nodal)  // the stiff penalty
+      quadratureWarning_ = format("Gauss %s with Penalty %g, below %g h / c = %g (h = %g, the shortest contact face "
+                                  "edge): Gauss points of flat faces lock against the curved capstan and the loops "
+                                  "stall (docs/contact.md, \"Stiff penalties\"); Auto gives this penalty Nodal",
+                                  gauss, settings.penalty, ContactSettings::kGaussPenaltyLimit,
+                                  ContactSettings::kGaussPenaltyLimit * hMin / c, hMin);
+    else if (exactStick)
+      quadratureWarning_ = format("Gauss %s under Coulomb in steady rolling: its exact stick has rows in the "
+                                  "saddle-point step only at the nodal rule's points, and without them the "
+                                  "multiplier loop crawls (docs/contact.md); Auto gives it Nodal",
+                                  gauss);
+  }
   // Automatic floor for the nodal rule only: with Gauss points the penalty
   // answer approaches an over-constrained one as eps2 -> 0 (flat faces cannot
   // touch a curved capstan at every Gauss point), and the multiplier loop

@@ -27,7 +27,8 @@ slice (inputs/pinch-roller-slice-steady.xml, inputs/pinch-roller-braked-steady.x
   * penalty contact under Coulomb (Contact/Method = Penalty at 1e-2, and 0.066, which
     the run warns about): Quadrature Auto gives exact stick the nodal rule, whose stick
     rows the saddle-point step takes; with Gauss 2x2 the loop crawled (6e-3: 85 Newton
-    iterations) or failed (1e-2). Each converges in at most 20 Newton iterations.
+    iterations) or failed (1e-2). Each converges in at most 20 Newton iterations; Gauss 2x2
+    named there is warned of.
 """
 import csv
 import os
@@ -210,5 +211,11 @@ for penalty in ("1e-2", "0.066"):
         T.conforms(out, os.path.join(out, "scene.xml"))
         n = sum(st["newton_iterations"] for st in s["steps"])
         T.check(s["converged"] and n <= 20, f"Penalty {penalty}: converged {s['converged']} in {n} Newton iterations (<= 20)")
+        T.check("Contact/Quadrature" not in p.stderr, f"Penalty {penalty}: no quadrature warning")
+# Gauss 2x2 named there: the run warns that the stick loop crawls without the nodal rule.
+p, s, out = T.run_scene(free, "penalty-gauss", sets=NOFIELDS + ["Capstans/capstan/Contact/Method=Penalty",
+                                                               "Capstans/capstan/Contact/Quadrature=Gauss 2x2"])
+T.check("Capstans/capstan/Contact/Quadrature': Gauss 2x2 under Coulomb in steady rolling" in p.stderr and free in p.stderr,
+        f"Gauss 2x2 named in steady rolling under Coulomb: warned ({p.stderr.strip()[:200]!r})")
 
 T.finish()
