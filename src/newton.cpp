@@ -24,6 +24,10 @@ namespace capstan {
 
 namespace {
 
+// |R| of a state with an inverted element (det F <= 0 at a Gauss point): 1e150
+// per dof (Assembly::evaluate); no physical residual comes near.
+constexpr double kInvertedResidual = 1e100;
+
 using ConverterT = Thyra::TpetraOperatorVectorExtraction<double>;
 
 // Whether a preconditioner has been built (holds an operator on some side).
@@ -607,6 +611,14 @@ NewtonResult NewtonSolver::solve(Vector& u, double tolerance) {
     if (std::string(e.what()).find("non-positive value for p^H*A*p") != std::string::npos)
       r.failure = "the tangent is not positive definite, which Solver/Linear Solver = CG needs (a rolling core, "
                   "friction or the pressure constraint can make it indefinite): use GMRES or Direct";
+    // A step the line search let through into an inverted element leaves a
+    // tangent no solver can use.
+    else if (!history->norms.empty() && history->norms.back() >= kInvertedResidual)
+      r.failure = "a Newton step inverted an element (det F <= 0 at a Gauss point), and the solve from there failed (" +
+                  r.failure + ")" +
+                  std::string(impl_->solver.lineSearch == SolverSettings::LineSearch::FullStep
+                                  ? "; Solver/Line Search = Full Step takes every step whole, Backtrack backs off"
+                                  : "");
   }
   r.failure = impl_->agreement.agree(r.failure);
   auto& out = params->sublist("Direction").sublist("Newton").sublist("Linear Solver").sublist("Output");
@@ -614,6 +626,12 @@ NewtonResult NewtonSolver::solve(Vector& u, double tolerance) {
   r.residualHistory = history->norms;
   r.stepLengths = history->steps;
   r.converged = status == NOX::StatusTest::Converged && r.failure.empty() && std::isfinite(r.residualNorm);
+  // A solve that ended at an inverted or non-finite state may have built its
+  // kept preconditioner there (NaN entries): the next solve builds its own.
+  // (Every retry of the sweep's H4 under Full Step failed on it at once.)
+  if (!r.converged &&
+      ((!history->norms.empty() && !(history->norms.back() < kInvertedResidual)) || !std::isfinite(r.residualNorm)))
+    rebuildPreconditioner();
   if (!r.converged && r.failure.empty()) {
     if (finite->getStatus() == NOX::StatusTest::Failed) r.failure = "residual is not finite (NaN/Inf)";
     else if (maxIters->getStatus() == NOX::StatusTest::Failed) r.failure = "Newton iteration limit reached";

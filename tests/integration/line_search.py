@@ -20,6 +20,10 @@ scene's Solver/NOX sublist (Line Search/Backtrack/Recovery Step = 1):
     GMRES (a randomized sweep's case): NOX's recovery step of 1 went from |R| 18 into
     an inverted state, every cut back then ended on Belos' NaN residual, exit 2;
     with capstan's setting it converges (exit 0), no cut back by NaN.
+  * the same with Line Search = Full Step (which takes every step whole): exit 2, the
+    failure naming the inverted element and the line search; every retry after a cut
+    makes Newton iterations of its own (the failed attempt's preconditioner, built at
+    the inverted state with NaN entries, had failed each retry's first solve at once).
 """
 import os
 import re
@@ -107,4 +111,13 @@ nan = [r for r in reasons if "NaN" in r or r.startswith("nonlinear solver error"
 T.check(s is not None and s["converged"] and not nan,
         f"H4, Tanh mu 1.87, Polynomial line search: converged {s is not None and s['converged']}, "
         f"{len(reasons)} cut backs, {len(nan)} by NaN or a solver exception")
+p, s, out = T.run_scene(T.input("seed/h4.xml"), "h4-full-step", quiet=False, expect_rc=2, extra=["--log", "newton"],
+                        sets=POLY[:-1] + ["Solver/Line Search=Full Step"])
+if s:
+    T.check("inverted an element" in s["failure"] and "Full Step" in s["failure"],
+            f"Full Step: the failure names the inverted element and the line search: {s['failure'][:200]!r}")
+    histories = newton_histories(out)
+    T.check(len(histories) > 3 and all(len(h) >= 2 for h in histories),
+            f"Full Step: each of {len(histories)} attempts makes Newton iterations "
+            f"(fewest residuals {min((len(h) for h in histories), default=0)})")
 T.finish()
