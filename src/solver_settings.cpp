@@ -83,7 +83,10 @@ void SolverSettings::declare(ParameterList& sol) {
           "| Rigid Roll (the last increment extrapolated, else the body turned with the core). "
           "The shift: the slice 18.7 Newton iterations per step against 57.6, the 3D drive 23% fewer "
           "(docs/numerics.md, Predictors)");
-  sol.set("Line Search", std::string("Backtrack"), "Backtrack | Polynomial | Full Step (NOX line search)");
+  sol.set("Line Search", std::string("Backtrack"),
+          "Newton's damping (NOX line search): Backtrack (halves the step until |R| falls) | Polynomial "
+          "(interpolates the step length) | Full Step (takes every Newton step whole, into inverted "
+          "elements too). A failed search takes no step, and the load step is cut");
   sol.set("Volume Tolerance", 1e-10, "Pressure loop ends when max |v_e/V_e - 1| is below this");
   sol.set("Max Pressure Iterations", 100, "Most pressure-anchor updates per step");
   sol.set("Pressure Update", std::string("Auto"),
