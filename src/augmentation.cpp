@@ -30,75 +30,38 @@ constexpr double kLaterPassReduction = 1e-4;
 // the 3D drive the same 578 Newton iterations over 20 steps; 1 gave 631, the
 // absolute tolerance 656 (docs/friction.md).
 constexpr double kPolishBelow = 10;
-// A starting guess (solve's passLimit: steady rolling's footprint and Tanh
-// stages) needs Newton only to this x r0, not to the step's tolerance: each
-// stage's last quadratic iteration changes nothing the next stage keeps.
-// Newton iterations from rest over 20 steady scenes and 14 hard cases
-// (scripts/steady-start-scales.py --hard): 1,009 and 1,299 converged; 919 and
-// 1,286 at 1e-7; 911 and 1,211 at 1e-6; 813 and 1,164 at 2e-6; 1,274 and
-// 1,273 at 1e-5 (the drive at mu = 1.5 cut: 436). The drive 36 -> 30. The
-// fine nips decide: their stick and slip cycle, and where each run ends up
-// follows its path. At 2e-6 the drive at 3x160x16 took 488 Newton iterations
-// (249 s; 33 at 1e-6, 37 at 1e-7, 43 converged), at 1e-6 the uniform radial
-// cells of tests/integration/hard_cases.py (3x160x8, Outer Cell Ratio = 1) did
-// not converge in 7 minutes (56 and 51 iterations at 1e-7 with either BLAS
-// kernel, 54 and 64 converged). Only where Newton's solves are direct: with
-// GMRES and a kept LU the 126k-dof drive on 2 ranks took 88 Newton iterations
-// and 5,211 Krylov, 339 s (at 2e-6), against 38, 1,288 and 93 s.
+// A starting guess (solve's passLimit: steady rolling's footprint and Tanh stages) needs Newton
+// only to this x r0 where its solves are direct: each stage's last quadratic iteration changes
+// nothing the next stage keeps (docs/steady-rolling.md, "Start from rest").
 constexpr double kGuessTolerance = 1e-7;
-// A saddle-point step is halved (down to kShortestPressureStep) while the
-// momentum residual it leaves is above kPressureStepMerit x the step's starting
-// residual (|R| and the scaled constraint errors): its linear model holds only
-// while no point crosses between stick, slip and free. 1 took the steady 3D
-// drive from rest in 80 Newton iterations (125 without), each step of its brake
-// sweep in 8-15 (8-29); 0.5 gave the same, 2 and 3 most of the loss back
-// (docs/friction.md). On the 126k-dof steady drive it halves two steps; the
-// run takes 108 Newton iterations, as a64e985 (without the test) did.
+// A saddle-point step is halved (to kShortestPressureStep at most) while the residual it leaves
+// exceeds kPressureStepMerit x its starting one: its linear model holds only while no point
+// crosses between stick, slip and free (docs/friction.md, "The multiplier loop in rolling").
 constexpr double kPressureStepMerit = 1;
 constexpr double kShortestPressureStep = 1.0 / 16;
-// Pressure Update = Monolithic: the step is Newton's, so it is solved closer
-// than the nested loop's 1e-3, to 1e-4. Three alternating rounds, Krylov
-// iterations and run times: the Hertz ring 123 and 1.36-1.87 s at 1e-4, 151
-// and 1.48-1.79 s at 1e-5, 180 and 1.85-2.36 s at 1e-6; G1 1x 102, 125 and
-// 143 (19, 17 and 16 steps), 0.20-0.27, 0.22-0.30 and 0.30-0.31 s.
+// Pressure Update = Monolithic: the step is Newton's, so it is solved closer than the nested
+// loop's 1e-3; tighter costs more Krylov iterations than the passes it saves
+// (docs/numerics.md, "The pressure loop").
 constexpr double kMonolithicStepTolerance = 1e-4;
-// With the saddle-point step the constraints fall fast from pass to pass (a
-// Newton step of the mixed problem); a loop whose worst constraint (over its
-// tolerance) has not come below its best for this many passes is failing:
-// the steady drive with a very soft stick (Tangential Penalty = 1) spent 50
-// passes (11 s of its 15) with the stick's slip growing 2e-3 -> 0.15 before
-// its retry with a stiffer stick converged; stopped at 10, 82 Newton
-// iterations and 4.6 s against 209 and 14 s, the same answer. No other scene
-// measured reaches it (the 13 behaviour scenes, the 8 steady ones, the
-// quasi-static drive, braked slice, slice and fast roller: identical).
+// With the saddle-point step the constraints fall fast from pass to pass; a loop whose worst
+// constraint (over its tolerance) has not come below its best for this many passes is failing,
+// and its retry is cheaper (docs/numerics.md, "A loop that stalls fails early").
 constexpr int kStallPasses = 10;
 // Points cycling between stick and slip (FrictionEffect::notePass) are held in
 // slip once the worst constraint has not come below its best for this many
 // passes (docs/steady-rolling.md, "Stick and slip that cycle").
 constexpr int kHoldAfterPasses = 3;
-// The last resort, once it has not for this many (of the kStallPasses that
-// end the solve): every point whose state has changed four times or more in
-// the solve is held in slip too. On the finest nips the loop's chatter is not
-// a 2-cycle: points go stick, slip, slip, stick, slip, slip, stick. Uniform
-// radial cells (3x160x8, Outer Cell Ratio = 1) then converge in 63 Newton
-// iterations and 25 s, where they were cut 7 times in 13 min (3x160x16 does
-// not: its Newton solves stagnate).
-// After 3 passes instead, it also held points where the loop was to converge
-// (3x100x8: 61 Newton iterations against 54, the speed ratio 1.4e-4 away);
-// after 6, every scene that converged converges as before, to the bit.
+// The last resort, once it has not for this many (of kStallPasses): every point whose state
+// changed four times or more is held in slip too, as fine nips' chatter is no 2-cycle; sooner,
+// it held loops about to converge (docs/friction.md, "The multiplier loop in rolling").
 constexpr int kHoldAnyAfterPasses = 6;
-// And once it has not for this many, every point's state is frozen (FrictionEffect::
-// notePass: in stick until its traction leaves the cone, then in slip), and the
-// stall test counts afresh from there. States that move one way only settle: the
-// uniform radial cells above converge so whatever the BLAS kernels' round-off
-// (54 and 64 Newton iterations with OpenBLAS' AVX2 and SSE kernels; with the SSE
-// ones they had not in 11 min).
+// And once it has not for this many, every point's state is frozen (FrictionEffect::notePass:
+// in stick until its traction leaves the cone, then in slip) and the stall test counts afresh:
+// states that move one way only settle (docs/friction.md, "The multiplier loop in rolling").
 constexpr int kFreezeAfterPasses = 8;
-// Frozen, the loop goes on while its worst constraint falls at least
-// kFrozenGain-fold over each kFrozenWindow passes, for at most kFrozenPasses
-// passes. Finer nips take more than 10 frozen passes (3x180x8: 9.8e6 -> 3.0 x
-// its tolerance in 10, 10x a pass early and 2x at the end); a loop stalled
-// otherwise (a 300x too soft stick) creeps, 1.4x in its second five.
+// Frozen, the loop goes on while its worst constraint falls at least kFrozenGain-fold over each
+// kFrozenWindow passes, for at most kFrozenPasses: finer nips need more than 10 frozen passes,
+// and a loop stalled otherwise creeps (docs/friction.md, "The multiplier loop in rolling").
 constexpr int kFrozenWindow = 5;
 constexpr double kFrozenGain = 2;
 constexpr int kFrozenPasses = 30;
@@ -188,11 +151,9 @@ bool AugmentationLoop::solveOnce(double t, double bare, StepRecord& rec, std::st
     } else {
       const auto& effects = m_.assembly->effects();
       setMultipliers(effects, mixing.next(multipliers(effects, true), multiplierMap(effects, true)), true);
-      // Rolling: contact and friction multipliers within their tolerance stay
-      // put. Moving them anyway (points flicker at the tolerance level as they
-      // pass through the nip) keeps changing the map the pressure loop's mixing
-      // works on, and it stalls. Elsewhere every multiplier moves each pass (a
-      // symmetric problem then stays symmetric to round-off).
+      // Rolling: contact and friction multipliers within their tolerance stay put, since points
+      // flickering at the tolerance would keep changing the mixing's map and stall it; elsewhere
+      // every multiplier moves each pass (a symmetric problem then stays symmetric to round-off).
       setMultipliers(effects, multiplierMap(effects, false), false, c.settled);
     }
     if (passLimit > 0 && it >= passLimit) return true;  // a starting guess: the moved state
@@ -272,14 +233,9 @@ AugmentationLoop::Pass AugmentationLoop::startPass(int it, double tol, PassPolic
     const double roundOff = fr->residualRoundOff(*m_.comm);
     if (roundOff > m_.absTolerance) pass.tolerance = std::max(pass.tolerance, roundOff);
   }
-  // A later pass that starts near Newton's tolerance is polished by one
-  // Newton step: Newton to 1e-3 x the absolute tolerance only stagnates where
-  // round-off is above it (8 iterations a step on the rolling slice after
-  // the saddle-point step; on the 3D drive the tolerance is the absolute
-  // one, 1e-13 c L^2, and round-off ~0.7-1.2x it), and how many iterations
-  // it takes first is tipped by round-off. Anderson's mixing needs its map
-  // at converged states: there only passes within the absolute tolerance
-  // (the steady slice under Tanh stalled at 100 passes with 10x Newton's).
+  // A later pass starting near Newton's tolerance gets one polishing Newton step, as a full
+  // solve stagnates at round-off; Anderson's mixing needs its map at converged states, so there
+  // only within the absolute tolerance (docs/friction.md, "The multiplier loop in rolling").
   const double polishBelow = m_.pressureStep ? kPolishBelow * tol : m_.absTolerance;
   pass.polish = !pass.stepAlone && it > 1 && pass.start <= polishBelow;
   return pass;
@@ -312,23 +268,9 @@ NewtonResult AugmentationLoop::solvePositions(double t, const Pass& pass, bool a
       m_.u->update(1.0, *start, 0.0);
       r = continuation_.solve(*m_.newton, *m_.u, pass.tolerance);
     }
-    // Under a regularised friction law (or Coulomb, below), where the retry failed too and
-    // the failure would cut the increment (not a pass after a saddle-point
-    // step, which is undone instead): the solve again from its
-    // start, in pseudo-time (NewtonSolver::pseudoTransient). Newton's line
-    // search only ever lowers |R|, and stops in a local minimum of |R| that is
-    // no solution: on H4's soft foundation the friction force's excess over
-    // the foundation's, which drags the block under the capstan, falls to 5%
-    // of it and rises again before it vanishes (docs/friction.md, "What step
-    // 2 is"). Cuts leave that landscape as it is, and the continuation's
-    // wider laws fold there. For Coulomb (after its smoothed-corner retry)
-    // only where the failed solve ends with every point slipping, as in H4's
-    // step 2, whose full slip does not depend on the path. Where points stick
-    // at the answer it does, to first order in the step, and a cut refined it:
-    // H4 at k = 0.01 now lands uncut 4e-3 from its answer in 4x smaller steps
-    // (tests/integration/hard_cases.py has that sequence). Where cuts do not
-    // get there either, the caller allows it in short sub-steps, where the
-    // path matters less (LoadStepper::advance).
+    // Where the retry failed too, before a cut: again in pseudo-time, past the |R| minimum that
+    // stops the line search; Coulomb only where all slip or in a cut's short sub-steps, where the
+    // path matters less (docs/friction.md, "What step 2 is, and the fallback for Tanh and Arctan").
     if (!r.converged &&
         (continuation_.regularised() || (continuation_.applies() && (pseudoTimeWithStick_ || everyPointSlips()))) &&
         !(pass.number > 1 && r.residualNorm <= m_.absTolerance) && !afterStep) {
@@ -431,11 +373,8 @@ void AugmentationLoop::moveByPressureStep(double t, Vector& f, const Constraints
   }
   if (!stepAlone) return;
   ++rec.newton;  // the monolithic system's Newton iteration
-  // A step its linear model did not carry whole (contact points entering or
-  // leaving): a Newton solve on the positions next, then steps again. (Tried
-  // on the steady drive's frictionless footprint, from the linear response:
-  // without it 12 steps, 7 of them halved, before the loop went on nested;
-  // with it 5 steps, then a Newton solve, then 2 steps.)
+  // A step its linear model did not carry whole (contact points entering or leaving): a Newton
+  // solve on the positions next, then steps again (docs/numerics.md, "The pressure loop").
   if (lastStepShortened_) passes.newtonNext();
 }
 

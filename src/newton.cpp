@@ -36,15 +36,9 @@ bool built(const Thyra::PreconditionerBase<double>& prec) {
          !prec.getLeftPrecOp().is_null();
 }
 
-// Times the preconditioner set-up (ILU factorisation, MueLu hierarchy) apart
-// from the Krylov iterations, for summary.json's timing breakdown: a thin
-// wrapper around the factory Stratimikos configured.
-//
-// With `lagged`, a preconditioner already built is kept until someone asks
-// for a rebuild (requestRebuild). Newton's matrices change little from one
-// iteration to the next, and within a step's pressure loop hardly at all, so
-// an old hierarchy still preconditions the new matrix well; NewtonSolver
-// asks for a rebuild when the Krylov iterations grow (LagPolicy below).
+// Times the preconditioner set-up apart from the Krylov iterations (summary.json's timing
+// breakdown). With `lagged` a built preconditioner is kept until requestRebuild: Newton's
+// matrices change little between iterations, so an old one still serves (LagPolicy below).
 class TimedPreconditionerFactory : public Thyra::PreconditionerFactoryBase<double> {
  public:
   TimedPreconditionerFactory(RCP<Thyra::PreconditionerFactoryBase<double>> inner, double& seconds, bool lagged)
@@ -81,12 +75,9 @@ class TimedPreconditionerFactory : public Thyra::PreconditionerFactoryBase<doubl
   mutable int builds_ = 0;
 };
 
-// When to rebuild a lagged preconditioner: after every Krylov solve, compare
-// its iterations with those of the first solve after the last rebuild. A
-// rebuild costs about as much as a few dozen Krylov iterations (MueLu on G1),
-// so the preconditioner is kept while the count stays within
-// `growth` x that baseline + `slack`, and rebuilt once it does not, or once a
-// solve hits its iteration limit.
+// When to rebuild a lagged preconditioner: kept while each Krylov solve's iterations stay within
+// `growth` x those of the first solve after the last rebuild + `slack`, and until a solve hits its
+// limit; a rebuild costs about as much as a few dozen Krylov iterations (MueLu on G1).
 class LagPolicy {
  public:
   LagPolicy(TimedPreconditionerFactory& factory, int maxIterations, double growth, int slack)
@@ -125,11 +116,9 @@ class BodyModel : public Thyra::StateFuncModelEvaluatorBase<double> {
     outArgs_ = out;
     nominal_ = in;
   }
-  // The initial guess holds the prescribed values on the constrained dofs;
-  // Newton moves only the free ones. (A Krylov solve to a loose tolerance,
-  // as Eisenstat-Walker asks for, leaves small non-zero components on the
-  // constrained rows of the Newton step; their residual is zero, so Newton
-  // would never correct that drift, and the supports would move.)
+  // The initial guess holds the prescribed values on the constrained dofs; Newton moves only
+  // the free ones: a loose Krylov solve leaves drift on the constrained rows, whose residual is
+  // zero, so Newton would never correct it and the supports would move.
   void setInitialGuess(const RCP<Vector>& u) {
     nominal_.set_x(Thyra::createVector(u, space_));
     if (pinned_.is_null()) {
@@ -232,20 +221,9 @@ struct NewtonSolver::Impl {
     params->set("Nonlinear Solver", "Line Search Based");
     auto& lsp = params->sublist("Line Search");
     lsp.set("Method", std::string(nameOf(solver.lineSearch, SolverSettings::lineSearches)));
-    // Backtrack (the default) halves the step until 0.5 |R|^2 decreases. An
-    // evaluation that inverts an element (det F <= 0 at a Gauss point) returns
-    // |R| = 1e150 per dof (Assembly::evaluate), so the line search backs off
-    // from it like from any increase, and NOX's FiniteValue test stops a solve
-    // that produces NaN. Contact status chattering (points entering and
-    // leaving contact between iterations, a residual that will not decrease)
-    // ends in the line search's failure, the Stagnation test or Max Newton
-    // Iterations: the solve reports failure and the step is cut, which is the
-    // remedy for both (a smaller increment moves fewer points across the
-    // kink). A failed line search takes no step (Recovery Step 0): NOX's
-    // default takes the full Newton step anyway, into inverted states where the
-    // tangent is singular (the direct solver throws), and at round-off, where no
-    // step decreases |R|, it wanders until Stagnation stops it
-    // (tests/integration/line_search.py measures both).
+    // Backtrack halves the step until |R| decreases (an inverted element gives |R| = 1e150); where
+    // none does (contact chattering, round-off) the solve fails and the step is cut, with no
+    // recovery step: NOX's full one lands in inverted states (docs/numerics.md, "Load steps").
     if (solver.lineSearch == SolverSettings::LineSearch::Backtrack) {
       lsp.sublist("Backtrack").set("Max Iters", 20);
       lsp.sublist("Backtrack").set("Recovery Step", 0.0);
@@ -256,14 +234,9 @@ struct NewtonSolver::Impl {
       lsp.sublist("Polynomial").set("Recovery Step", 0.0);
     auto& newton = params->sublist("Direction").sublist("Newton");
     newton.sublist("Linear Solver").set("Tolerance", solver.linearTolerance);
-    // Eisenstat-Walker (NOX's Type 2): far from the solution a Krylov solve to
-    // 1e-10 is wasted work, since the next Newton step changes the system
-    // anyway. Solving to eta_k ~ (|R_k|/|R_k-1|)^1.5 keeps Newton superlinear
-    // and cuts the Krylov iterations 2.5x (docs/performance.md, "Defaults and
-    // why"). The answer is the same: Newton still converges to its own tolerance.
-    // Not with an LU preconditioner: GMRES converges in a few iterations
-    // whatever the tolerance, and loose solves only cost Newton iterations
-    // (the 3D drive's first step: 77 against 51).
+    // Eisenstat-Walker (NOX's Type 2): far from the solution a tight Krylov solve is wasted work;
+    // eta_k ~ (|R_k|/|R_k-1|)^1.5 keeps Newton superlinear. Not with the LU preconditioner, where
+    // loose solves only cost Newton iterations (docs/performance.md, "Defaults and why").
     if (solver.linearToleranceMethod == SolverSettings::ToleranceMethod::Adaptive &&
         solver.preconditioner != SolverSettings::Preconditioner::LU) {
       newton.set("Forcing Term Method", "Type 2");
@@ -319,11 +292,9 @@ NewtonSolver::NewtonSolver(Assembly& assembly, const SolverSettings& settings)
   }
   impl_->model = rcp(new BodyModel(assembly, impl_->lows));
   impl_->W = impl_->model->create_W_op();
-  // MueLu and Ifpack2 read their parameters only when a preconditioner is
-  // built. A scene that passes its own (Solver/Stratimikos/Preconditioner
-  // Types, or Solver/Ifpack2 to an Ifpack2 preconditioner) gets one built now,
-  // on the tangent at the undeformed state, so that a bad name or value stops
-  // the run before anything is written.
+  // MueLu and Ifpack2 read their parameters only when a preconditioner is built: a scene that
+  // passes its own gets one built now, on the undeformed tangent, so that a bad name or value
+  // stops the run before anything is written.
   const auto& strat = solver.stratimikos;
   const bool ownIfpack2 = solver.ifpack2.numParams() > 0 && impl_->strat.get<std::string>("Preconditioner Type", "") == "Ifpack2";
   if (!impl_->newtonPrecFactory.is_null() && (strat.isSublist("Preconditioner Types") || ownIfpack2)) {

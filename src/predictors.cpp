@@ -8,12 +8,9 @@ namespace capstan {
 
 namespace {
 
-// The predictor's solve with the factorisation Newton kept from the last step
-// (GMRES with the LU preconditioner) instead of a new one: to this tolerance,
-// in at most this many iterations, else with a new one. G1 2x: 242 GMRES
-// iterations against 207 and 5 factorisations fewer, 1.34-1.50 -> 1.19-1.23 s
-// on 1 rank, 0.88 -> 0.83-0.86 s on 2; the same Newton iterations, forces
-// within 2e-12. To 1e-6 it took 15-17 iterations a step and gained half that.
+// The predictor's solve with the factorisation Newton kept from the last step (GMRES with the
+// LU preconditioner) instead of a new one, to this tolerance in at most this many iterations,
+// else with a new one: fewer factorisations (docs/performance.md, "Defaults and why").
 struct PredictorOnKept {
   double tolerance;
   int maxIterations;
@@ -172,11 +169,9 @@ void Predictors::tangent(double t0, double t1, double bare, StepRecord& rec, boo
   // Into Newton's matrix (Newton reassembles it before it solves): a matrix of
   // the predictor's own would cost memory (docs/performance.md).
   const RCP<FEMatrix> W = m_.newton->matrix();
-  // Effects linearise for the predictor: the bare state penetrates the
-  // capstans by the whole increment (contact leaves out its geometric
-  // stiffness, t_n / d, large there) and slides over them by the capstan's
-  // whole travel (friction assumes stick: the body follows the capstan, which
-  // a slipping linearisation, with no stiffness along the slip, cannot see).
+  // Effects linearise for the predictor: contact leaves out its geometric stiffness (t_n / d,
+  // large where the bare state penetrates by the whole increment) and friction assumes stick, so
+  // the body follows the capstan, which a slipping linearisation cannot see.
   for (const auto& e : assembly.effects()) e->setPredicting(true);
   const bool valid = assembly.evaluate(*m_.u, &f, W.get(), &z, &Kz);
   if (!valid) {

@@ -326,18 +326,9 @@ PressureStep::Result PressureStep::solve(const CrsMatrix& K, const Inverse& Kinv
   }
   Block x = newBlock(), work = newBlock();
   const double beta0 = std::sqrt(dot(rhs, rhs));
-  // Done early once the volume error predicted after the next Newton solve
-  // meets predictionTarget (measuredAfterNewton): the momentum residual the
-  // step leaves is Newton's to remove next, and that moves the volumes too
-  // (the Hertz roller, stopped on the step's own volume error at a 3e-2..3e-1
-  // reduction, measured 10-40x it and never met the tolerance with the
-  // Laplacian Schur term). The prediction costs a K~^-1: it is checked only
-  // where the step's own volume error meets the target, and again only once
-  // the residual has halved.
-  // Otherwise done once the residual is reduced by `tolerance` and the volume
-  // error left meets the target, or is far from it anyway. Going on past
-  // `tolerance` is worth at most as many iterations again (+10): a target
-  // below what round-off allows must not run to maxIterations.
+  // Done early once the volume error predicted after the next Newton solve meets the target (the
+  // step's own error misses what that solve moves); else at `tolerance`, going on past it at most
+  // as many iterations again (docs/numerics.md, "When a step stops").
   const double predictionTarget = volumeTarget / missRatio_;
   result.predictionTarget = predictionTarget;
   int reachedAt = -1;       // iterations when the residual first met `tolerance`

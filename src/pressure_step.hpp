@@ -83,29 +83,14 @@ class PressureStep {
     bool lu = false;            // preconditioned by the factored block matrix (else block-triangular)
     std::string luRefused;      // non-empty: MUMPS refused to factor it (why), Block from then on
   };
-  // At the last evaluation (f its residual, K its tangent, the effects' states
-  // and the positions): dx (owned dofs, zero on held ones) and dmu.
-  // GMRES stops early once the volume error predicted after the next Newton
-  // solve (max_e, relative: the step's own constraint residual plus
-  // B^T K~^-1 r_u, the volume change of removing the momentum residual r_u it
-  // leaves) is at most volumeTarget / (the ratio its last prediction missed
-  // by, measuredAfterNewton; at least 1). Otherwise it reduces the residual by
-  // `tolerance` and stops there if the volume error the step leaves is at most
-  // volumeTarget (this pass then meets the volume tolerance) or still above
-  // 10 volumeTarget (the next pass, quadratically closer, finishes the job);
-  // close to the target it goes on until it meets it (for at most as many
-  // iterations again), since a pass (a Newton solve and a pressure step) costs
-  // more than the iterations that remain. volumeTarget 0: the reduction alone.
-  // dmu: every effect's multiplier changes, in its multipliers() layout
-  // (zero where it has no row; empty views for effects without multipliers).
+  // At the last evaluation (f, K, the effects' states, the positions): dx (owned dofs, zero on
+  // held ones) and dmu (each effect's, in its multipliers() layout, zero where it has no row).
+  // GMRES stops on the volume error against volumeTarget (docs/numerics.md, "When a step stops").
   Result solve(const CrsMatrix& K, const Inverse& Kinv, const Vector& f, double tolerance, double volumeTarget,
                int maxIterations, Vector& dx, std::vector<Kokkos::View<double*>>& dmu);
-  // The volume error measured after each Newton solve of the pressure loop.
-  // If the last step stopped on its prediction (and made progress, so that the
-  // step was taken), the ratio measured / predicted (at least 1) divides the
-  // following steps' target for the prediction: it misses what K~^-1 misses
-  // of K^-1 (G1: ~1-1.4x; the Hertz roller 5-20x, which without the ratio
-  // hovered above its volume tolerance pass after pass).
+  // The volume error measured after each Newton solve of the pressure loop: where the last step
+  // stopped on its prediction, measured / predicted (at least 1) divides the next targets, since
+  // K~^-1 misses part of K^-1 (docs/numerics.md, "When a step stops").
   void measuredAfterNewton(double volumeError);
   // The last step was taken shortened: its prediction does not apply.
   void shortened() { lastPredicted_ = 0; }

@@ -5,12 +5,9 @@
 namespace capstan {
 
 namespace {
-// The first string parameter under `list` (path `at`) that names Ifpack2's
-// block relaxation, as "path = value", or "". In Trilinos 13.2 it crashes on
-// capstan's matrices: as MueLu's smoother on the Hertz ring, block Gauss-Seidel
-// over radial lines segfaulted in its first apply, and the line partitioner
-// (3 equations a node) corrupted the heap at a detection threshold of 0.2
-// (docs/performance.md, "Defaults and why", the MueLu rows).
+// The first string parameter under `list` (path `at`) that names Ifpack2's block relaxation,
+// as "path = value", or "": in Trilinos 13.2 it crashes on capstan's matrices
+// (docs/performance.md, "Defaults and why").
 std::string blockRelaxationIn(const Teuchos::ParameterList& list, const std::string& at) {
   for (auto it = list.begin(); it != list.end(); ++it) {
     const std::string path = at + "/" + list.name(it);
@@ -166,22 +163,9 @@ SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterRe
   s.lineSearch = r.choice(sol, at, "Line Search", lineSearches);
   s.volumeTolerance = r.fraction(sol, at, "Volume Tolerance");
   s.maxPressureIterations = r.atLeast(sol, at, "Max Pressure Iterations", 1);
-  // Auto: the saddle-point step without friction (docs/performance.md,
-  // "Defaults and why"), for quasi-static rolling with friction, whose
-  // multipliers move with the streamline shift (the fast rollers 51.7 Newton
-  // iterations per step against 83.5 with Anderson), and for steady rolling,
-  // with Coulomb's sticking points among its rows (the steady drive 98 Newton
-  // iterations against 168). Other friction scenes keep Anderson: with the step
-  // H4 at k = 0.01 takes another stick/slip path, 1.3e-4 from its finely
-  // stepped reference (docs/friction.md, "The multiplier loop in rolling").
-  // Without friction the step is Newton's own (Monolithic): G1 1x 19 steps
-  // against 33 Newton iterations and 15 steps, 0.27 s against 0.37 s; the
-  // Hertz ring 1.45 s against 1.86 s. Only with exact linear solves: with
-  // MueLu each step's GMRES gets one V-cycle per K^-1, and the gain fades
-  // (G1 2x 4.34 s against 5.02 s, 4x 51.1 against 49.6 s with 13% more
-  // memory; docs/performance.md, "Defaults and why"). With friction
-  // each step moves points between stick, slip and free, and the steady
-  // drive's first friction solve diverged.
+  // Auto: without friction the saddle-point step alone (Monolithic) where linear solves are exact,
+  // else after each Newton solve, as for rolling with friction; other friction scenes keep
+  // Anderson, as the step changes their stick/slip path (docs/performance.md, "Defaults and why").
   enum class Update { Auto, SaddlePoint, Monolithic, Anderson };
   const Update update = r.choice(sol, at, "Pressure Update",
                                  std::vector<std::pair<const char*, Update>>{{"Auto", Update::Auto},
@@ -207,13 +191,9 @@ SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterRe
       r.choice(sol, at, "Pressure Step Factorisation",
                std::vector<std::pair<const char*, bool>>{{"Newton's", true}, {"New", false}});
   s.pressureAccelerationDepth = r.atLeast(sol, at, "Pressure Acceleration Depth", 0);
-  // Automatic: the fastest on G1 for each update (docs/performance.md,
-  // "Defaults and why"): 3e-2 with the saddle-point step, 1e-2 with Anderson;
-  // with friction 1e-2 (the fast rollers: 51.7 Newton iterations per step
-  // against 68.1 at 3e-2, docs/friction.md); the monolithic loop 1e-2
-  // (kMonolithicSolvePenalty, set by Model: G1 2x 204 GMRES iterations against
-  // 267, 2.09 s against 2.39 s, the Hertz ring 102 against 132; 2e-2, 7e-3 and
-  // 5e-3 took more).
+  // Automatic: the fastest on G1 for each update, 3e-2 with the saddle-point step and 1e-2 with
+  // Anderson; 1e-2 with friction and for the monolithic loop (kMonolithicSolvePenalty, set by
+  // Model) (docs/performance.md, "Defaults and why").
   s.minimumSolvePenalty = sol.get<double>("Minimum Solve Penalty");
   if (!(s.minimumSolvePenalty > 0 || s.minimumSolvePenalty == -1) || !std::isfinite(s.minimumSolvePenalty))
     r.fail("Solver/Minimum Solve Penalty", "must be > 0, or -1 (automatic), got " + Teuchos::toString(s.minimumSolvePenalty));
@@ -237,25 +217,17 @@ SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterRe
 SolverSettings SolverSettings::resolved(long dofs, bool annulus, bool friction, bool steady) const {
   SolverSettings s = *this;
   s.gradedRings = gradedRings || annulus;  // NewtonSolver resolves again, knowing no mesh
-  // Auto's direct size: 50,000 on an annulus; on a box 5,000, and 40,000 for
-  // the monolithic loop (no friction), whose steps a factorisation (of the
-  // symmetric part) serves better than MueLu's V-cycle: G1 2x (10,179
-  // unknowns) 1.40 s with the LU preconditioner against 4.35 s with MueLu;
-  // G1 3x (31,863) 13.8-13.9 s against 16.4-16.6 s, with 1.5x the memory
-  // (395 against 268 MiB); G1 4x (72,675) 75.4 s against 46.6 s
-  // (docs/performance.md, "Defaults and why").
+  // Auto's direct size: 50,000 on an annulus; on a box 5,000, and 40,000 for the monolithic loop
+  // (no friction), whose steps a factorisation of the symmetric part serves better than MueLu's
+  // V-cycle up to about there (docs/performance.md, "Defaults and why").
   const long most = s.directSolverMaxDofs > 0 ? s.directSolverMaxDofs
                     : annulus                  ? 50000
                     : s.monolithic && !friction ? 40000
                                                : 5000;
   if (s.linearSolver == LinearSolver::Auto && steady) {
-    // Steady rolling: a factorisation every Newton iteration up to the direct
-    // solver's size, as with friction elsewhere (the 3D drive 1.55-1.68 s
-    // against 1.93-1.97 s with a kept one, the slice's brake sweep 0.55 against
-    // 0.62-0.64 s, the Carter coating 8.2 against 10.2 s; the same answers:
-    // docs/steady-rolling.md); above it GMRES with a kept factorisation. Never
-    // MueLu: omega's row (the torque balance) has no diagonal, which smoothers
-    // cannot take.
+    // Steady rolling: a factorisation every Newton iteration up to the direct solver's size, GMRES
+    // with a kept one above (docs/steady-rolling.md, "Measurements"). Never MueLu: omega's row
+    // (the torque balance) has no diagonal, which smoothers cannot take.
     s.linearSolver = dofs > most ? LinearSolver::GMRES : LinearSolver::Direct;
     if (s.linearSolver == LinearSolver::GMRES && s.preconditioner == Preconditioner::Auto)
       s.preconditioner = Preconditioner::LU;

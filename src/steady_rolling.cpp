@@ -13,42 +13,21 @@ namespace capstan {
 
 namespace {
 
-// Tanh and Arctan scenes whose slip speed scale lies below the first stage's
-// by more than this ratio start through their own law at the stages' scales,
-// which go on falling by this ratio to about the scene's: the drive under Tanh
-// 1e-4 in 83 Newton iterations against 453 through friction at the held
-// angular velocity (docs/steady-rolling.md, "Tiny regularisation"); ratios of
-// 3 and 10 took 317 and 293 over five scenes against 288.
+// Tanh and Arctan scenes whose slip speed scale lies below the first stage's by more than this
+// ratio start through their own law, its scale falling by this ratio a stage to about the
+// scene's, not through friction at the held omega (docs/steady-rolling.md, "Tiny regularisation").
 constexpr double kStartStageRatio = 5;
-// A start stage that fails is tried again from the last one's answer after a
-// stage halfway (in log) between them (the first: after one 5x wider), this
-// many times in a start: the drive at 8x its force, whose 0.004 stage failed,
-// in 261 Newton iterations with no cut against 868 and 3 cuts (4 refinements
-// at 10x: no better; docs/steady-rolling.md, "Large indentation").
+// A start stage that fails is tried again from the last one's answer after a stage halfway (in
+// log) between them (the first: after one 5x wider), this many times in a start: large
+// indentations then start without cuts (docs/steady-rolling.md, "Large indentation").
 constexpr int kStageRefinements = 2;
-// The Tanh stages are starting guesses: one pass each, a Newton solve and the
-// saddle-point step (AugmentationLoop::solve's passLimit). The drive 43 Newton
-// iterations against 52 with each converged, the slice 18/22, the braked
-// slice 19/25, the Carter coating 18/22; the 126k-dof drive on 2 ranks 49
-// against 56 (118 s against 122 s). The frictionless footprint too, where
-// Newton's solves are direct: the drive 42 against 44, the slice 15/18, the
-// Carter coating 11/14, mu = 2 71/82, the sweeps 1-3 fewer. With GMRES and a
-// kept LU (above the direct solver's size) it stays converged: one pass took
-// the 126k drive to 175 s (its first Tanh solve 1,087 Krylov iterations
-// against 184).
+// The Tanh stages (and, where Newton's solves are direct, the frictionless footprint) are starting
+// guesses: one pass each, a Newton solve and the saddle-point step; with GMRES and a kept LU one
+// pass costs Krylov iterations (docs/steady-rolling.md, "Start from rest").
 constexpr int kGuessPasses = 1;
-// Where the steady state after the Tanh stages fails, it is solved again from
-// their answer with Coulomb's stick (eps_t, its tangential penalty) this much
-// softer than the automatic one, then 3x that: softer than the default, and
-// stiffer than a scene's much softer stick (eps_t = 1, 300x the automatic on
-// the drive, did not converge in 50 passes at any load: now 209 Newton
-// iterations). The drive at mu = 1.1-2 failed (the Newton solve
-// stagnated at |R| ~1e-2, and so did friction at the held angular velocity);
-// through the retries mu = 1.1, 1.2, 1.3, 1.5 and 2 converge in 125, 134, 91,
-// 71 and 82 Newton iterations (10x alone left 1.2 failing; retries from the
-// footprint, through the Tanh stages again, took 100-178). Not the default: at
-// 10x the drive's brake sweep took up to 25 Newton iterations a step against
-// 15, at 30x 188 and a cut.
+// Where the steady state after the Tanh stages fails, it is solved again from their answer with
+// Coulomb's stick (eps_t) this much softer than the automatic one, then 3x: high friction then
+// converges; as the default it slows the brake sweep (docs/steady-rolling.md, "High friction").
 constexpr double kRetryStickSoftening = 10;
 
 }  // namespace

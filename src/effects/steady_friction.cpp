@@ -129,12 +129,9 @@ void SteadyFrictionEffect::useSceneLaw(bool seed) {
   if (sceneLaw_ != FrictionSettings::Law::Coulomb) return;
   settings_.law = FrictionSettings::Law::Coulomb;
   parameters_.law = kernels::FrictionLaw::Coulomb;
-  // lambda_T = t. Tried: lambda_T = t - du_t / eps_t, which makes Coulomb's
-  // trial traction at this state Tanh's traction (every point starts sticking
-  // with the traction it has): the drive's sweep from rest took 42 Newton
-  // iterations against 66, the rest within 1-2, but the 126k-dof drive 210 s
-  // against 118 s (its first Coulomb solve by GMRES with the Tanh stage's kept
-  // LU: 1,229 Krylov iterations) and a speed ratio 2.3e-5 away.
+  // lambda_T = t. Seeding lambda_T = t - du_t / eps_t instead (Tanh's traction as Coulomb's
+  // trial traction) cost the 126k-dof drive's GMRES solves dearly (docs/steady-rolling.md,
+  // "Start from rest").
   if (seed) multiplierMap(tangentialMultipliers_);
 }
 
