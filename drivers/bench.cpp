@@ -77,18 +77,9 @@ double fmaPeak() {
   return r;
 }
 
-// Flops of brickResidualTangent counted from its loops (kernels/brick.hpp; a
-// fused multiply-add is 2; checked by running the kernel with an
-// operation-counting type in place of double):
-//   Gauss-point geometry, per point: dX/dxi and dx/dxi 2 x 144, inverse of
-//   dX/dxi 42, F = (dx/dxi)(dX/dxi)^{-1} 45, F^{-1} and det F 42, wJ 1  -> 418
-//   per point: volume, 2c wJ, q wJ 3; D, d, G 3 x 120; H 72, R 24, g 48  -> 507
-//   per element: p(v) and q 6
-//   tangent, per point: e 24, 2c wJ D 24  -> 48
-//   tangent products: S_ab for all 64 node pairs (both triangles, one vector
-//   operation a row) 8 x 8 x 8 x 3 x 2 = 3072; the H d and e d sums (the e d
-//   one, T, symmetric and also formed in full) 2 x (24 x 24 x 8 x 2) = 18432;
-//   1/(eps V) 2, g g^T/(eps V) 24 + 576, S added 192.
+// Flops of brickResidualTangent counted from its loops (kernels/brick.hpp; a fused multiply-add is
+// 2, checked with an operation-counting type): per Gauss point, per element and the tangent's
+// products, term by term in docs/performance.md, "Kernels and assembly".
 constexpr double kBrickFlopsResidual = 8 * (418 + 507) + 6;  // 7406
 constexpr double kBrickFlopsTangent =
     kBrickFlopsResidual + 8 * 48 + 3072 + 18432 + 2 + 24 + 576 + 192;  // 30088

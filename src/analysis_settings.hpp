@@ -21,16 +21,9 @@ struct AnalysisSettings {
   Type type = Type::QuasiStatic;
   // Steady rolling: order of the upwind difference along the rings (1 or 2).
   int upwindOrder = 2;
-  // Steady rolling with Coulomb friction (or a much narrower Tanh or Arctan):
-  // the Tanh laws the start from rest passes through, as fractions of the
-  // capstan's surface speed, widest first. Newton's count depends on them
-  // irregularly, scene by scene, so they were chosen by totals
-  // (scripts/steady-start-scales.py): over 20 scenes (the eight steady ones,
-  // twelve variants of the drive) 993 Newton iterations against 1,057 for
-  // {0.02, 0.004} and 1,010-1,241 for eight other sets of three or four; over
-  // 14 hard cases 1,304 against 1,339. The drive 36 against 42, the 126k-dof
-  // drive 38 (77 s) against 44 (106 s); with a tangential penalty of 1e-6 160
-  // against 114 (docs/steady-rolling.md, "Start from rest").
+  // Steady rolling with Coulomb friction (or a much narrower Tanh or Arctan): the Tanh laws the
+  // start from rest passes through, as fractions of the capstan's surface speed, widest first;
+  // chosen by the Newton totals over many scenes (docs/steady-rolling.md, "The scales").
   std::vector<double> startSlipScales = {0.06, 0.015, 0.004};
 
   bool steady() const { return type == Type::SteadyRolling; }

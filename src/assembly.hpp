@@ -66,26 +66,17 @@ class Assembly {
   // cores' face nodes to where the cores' values in u put them.
   void applyConstraints(Vector& u, double t);
 
-  // Runs every effect at displacement u and assembles the residual f (if not
-  // null) and the tangent W (if not null). Constrained rows: f = 0 and W has the
-  // identity in row and column (u already holds the prescribed values, so the
-  // Newton update there is zero and the elimination keeps W's structure).
-  // With z and Kz (and W): also Kz = K z with the element tangents of this
-  // evaluation, no constraints applied: the load a prescribed increment z
-  // causes, for the step predictor (the tangents are not kept to form it later).
-  // Returns false if an element is inverted (det F <= 0 at a Gauss point).
+  // Runs every effect at u into the residual f and tangent W (each if not null); a constrained row
+  // has f = 0 and W's identity (u holds its value). With z and Kz: Kz = K z, unconstrained, from
+  // these element tangents (the predictor's load). False if an element is inverted.
   bool evaluate(const Vector& u, Vector* f, FEMatrix* W, const Vector* z = nullptr, Vector* Kz = nullptr);
   // z = prescribed displacement increment from t0 to t1 (zero on free dofs).
   // turned: the cores' prescribed turns already in u (Constraints::increment).
   void constraintIncrement(Vector& z, double t0, double t1, bool turned = false) const;
 
-  // Per-entity vectors of effect e over its dofs (values: entities x dofs,
-  // e.g. each brick's d v_e / d x) as sparse rows over the free global dofs of
-  // dofMap(), with the chain rule the matrix assembly applies: a rigid core's
-  // face-node entries go to the core's free unknowns (the translations, and
-  // the rotation through du/dtheta at the last evaluation); held dofs drop.
-  // Row r is cols/vals[rowStart[r] .. rowStart[r + 1]), each column once.
-  // entities: row r's entity, if not one row per entity in order.
+  // Effect e's per-entity vectors (values: entities x dofs, e.g. d v_e / d x) as sparse rows over
+  // dofMap()'s free dofs, by the matrix's chain rule (held dofs drop): row r is
+  // cols/vals[rowStart[r], rowStart[r + 1]); entities: row r's entity, if given.
   void chainRows(const Effect& e, const Matrix& values, std::vector<size_t>& rowStart, std::vector<GO>& cols,
                  std::vector<double>& vals, const std::vector<int>* entities = nullptr) const;
 
@@ -131,12 +122,9 @@ class Assembly {
   double time_ = 0;
   RCP<FEGraph> graph_;
   std::vector<std::vector<LO>> columns_;  // per effect: [entity * dofs + k] matrix column ids
-  // Per effect: where its kernel puts each entity's tangent (effects/effect.hpp): the
-  // CRS offsets of its 3-column blocks and held columns, found once (4-byte
-  // offsets, one per block: a sixth of the memory and traffic of one 8-byte
-  // offset per entry; a rank's matrix holds fewer than 2^31 entries), and the
-  // kept copies for the rigid-core chain rule. Each evaluation adds the
-  // matrix's values (and the predictor's K z).
+  // Per effect: where its kernel adds each entity's tangent (effects/effect.hpp), found once: a
+  // 4-byte CRS offset per 3-column block (< 2^31 entries a rank), held columns, copies kept for the
+  // cores (docs/performance.md, "Assembly without stored element tangents").
   std::vector<TangentSink> sinks_;
   RCP<const Tpetra::Import<>> importer_;
   RCP<Vector> uOverlap_, zOverlap_;

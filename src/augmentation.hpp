@@ -21,12 +21,9 @@
 
 namespace capstan {
 
-// Which passes are a saddle-point step alone (Pressure Update = Monolithic:
-// Newton's method on the mixed problem) and which a Newton solve on the
-// positions. Monolithic: steps alone from the predictor on; a Newton solve only
-// after a step that made no progress or was halved, where the constraints are
-// met and the momentum residual is not, and after kMonolithicPasses passes (the
-// nested loop converges from further away). The nested loops: always Newton.
+// Which passes are a saddle-point step alone (Pressure Update = Monolithic: Newton on the mixed
+// problem) and which a Newton solve: monolithic, a Newton solve only after a step that made no
+// progress or was halved, and after kMonolithicPasses. The nested loops: always Newton.
 class PassPolicy {
  public:
   static constexpr int kMonolithicPasses = 12;
@@ -51,13 +48,9 @@ class AugmentationLoop {
   // checkTangent: compare the assembled tangent with differences of the
   // residual before each solve and after a failed one (--check-tangent).
   AugmentationLoop(Model& model, Log& log, bool checkTangent);
-  // Solves the increment ending at t from the first guess in u. `bare`: the
-  // residual norm of the bare increment (Newton's tolerance is relative to
-  // it). Adds its iterations to rec. False with `failure` set if Newton or
-  // the loop failed (u and the multipliers are then the caller's to restore).
-  // passLimit > 0: the solve ends after that many passes (each a Newton solve
-  // and the multipliers' move) whether the tolerances are met or not: a
-  // starting guess for the next solve (steady rolling's start from rest).
+  // Solves the increment ending at t from the guess in u (`bare`: the bare increment's residual,
+  // Newton's reference), adding to rec; false with `failure` set (the caller restores u and the
+  // multipliers). passLimit > 0: stop after that many passes, met or not (a first guess).
   bool solve(double t, double bare, StepRecord& rec, std::string& failure, int passLimit = 0);
   // Coulomb: whether a failed solve may go on in pseudo-time while points
   // stick (LoadStepper: in sub-steps cut a few times; otherwise only where
@@ -117,11 +110,9 @@ class AugmentationLoop {
   // contact and friction, then the step where a constraint with rows is unmet.
   void moveByPressureStep(double t, Vector& f, const Constraints& c, bool stepAlone, PassPolicy& passes,
                           std::optional<StepStart>& beforeStep, StepRecord& rec);
-  // The saddle-point step at the converged state (src/pressure_step.hpp):
-  // moves u and the multipliers together. False if the block solve made no
-  // progress (nothing is changed then).
-  // volumeMet: the volumes already meet their tolerance (a step for other rows).
-  // monolithic: no Newton solve follows (Pressure Update = Monolithic).
+  // The saddle-point step at the converged state (src/pressure_step.hpp): moves u and the
+  // multipliers; false, nothing changed, if the block solve made no progress. volumeMet: the
+  // volumes are met already; monolithic: no Newton solve follows.
   bool saddlePointPressureStep(double t, Vector& f, bool volumeMet, bool monolithic, StepRecord& rec);
   // One full Newton step from u, whose residual `start` is within the
   // absolute tolerance, kept if it lowers the residual: one iteration.

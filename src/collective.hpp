@@ -25,13 +25,9 @@ void agreeRuntime(const Comm& comm, std::string error);
 // Rank 0's string on every rank.
 std::string broadcastString(const Comm& comm, std::string s);
 
-// Whether a step that can fail on some ranks alone (an exception inside a
-// Trilinos solver) failed anywhere, agreed on a communicator of its own. A
-// rank-local exception inside a collective call leaves the other ranks
-// inside that call for good: a failed rank waits for the others at most
-// `patience` seconds, then reports and ends the job (MPI_Abort, exit 2)
-// rather than hang. Construct it on every rank at once (it duplicates the
-// communicator).
+// Whether a step that can fail on some ranks alone (a Trilinos solver's exception) failed anywhere.
+// The others would wait in that collective call for good, so a failed rank waits `patience` s, then
+// ends the job (MPI_Abort, exit 2). Construct on every rank at once (it duplicates the comm).
 class FailureAgreement {
  public:
   explicit FailureAgreement(const RCP<const Comm>& comm);

@@ -51,13 +51,9 @@ bool anyRank(bool local, MPI_Comm comm) {
   return out != 0;
 }
 
-// MumpsOptions::symmetricPart: for a square matrix distributed by rows, which
-// entries lie above the diagonal (by global ids: MUMPS reads one triangle of a
-// symmetric matrix) and, for each below it, where its transpose's value is, on
-// this rank or another (then exchanged at each factorisation). Built once a
-// pattern: each row's entries sorted by column for a binary search; the
-// transposes in other ranks' rows asked of their owners, who note which of
-// their entries to send. Both calls are collective.
+// MumpsOptions::symmetricPart: which entries of a square row-distributed matrix lie above the
+// diagonal (MUMPS reads one triangle) and where each lower one's transpose is, here or on its owner
+// (exchanged at each factorisation). Built once a pattern; both calls are collective.
 class TransposeEntries {
  public:
   using CrsMatrix = Tpetra::CrsMatrix<>;

@@ -32,22 +32,9 @@
 namespace capstan {
 
 struct MumpsOptions {
-  // Fill-reducing ordering of the (sequential) analysis. Debian's libmumps has
-  // neither METIS nor SCOTCH compiled in (ICNTL(7) = 5 silently falls back to
-  // AMF), so Metis computes METIS_NodeND's ordering here, on rank 0 from the
-  // gathered pattern of A + A^T, and hands it to MUMPS (ICNTL(7) = 1, PERM_IN).
-  // Measured on a 3D 27-point, 3-dof elasticity-like stencil, 52,728 unknowns,
-  // 1 rank, Debian's reference BLAS (test_mumps, MumpsTiming; factor entries,
-  // factorisation time): Metis 78 M, 34-36 s; Pord 91 M, 58-61 s; AMF 112 M,
-  // 113-120 s; AMD and QAMD 120 M, 103-155 s. The analysis takes 0.2-0.6 s
-  // with any of them (Metis' includes gathering the pattern and METIS_NodeND).
-  // The factorisation is BLAS-bound: with OpenBLAS (one thread) in place of the
-  // reference BLAS, Metis 3.8 s, Pord 5.4 s, AMF 7.8 s (2 ranks, Metis: 2.3 s).
-  // Auto (the default): METIS and QAMD both analysed, the one the analysis
-  // estimates at fewer factorisation flops kept. The 3D drive (4,806
-  // unknowns, a thin ring): QAMD 1.38e8 flops against METIS 2.03e8, 8% less
-  // time per Newton iteration; the Hertz ring (15,126): METIS 8.4e8 against
-  // 1.07e9 (docs/performance.md, "Linear solvers").
+  // Fill-reducing ordering of the (sequential) analysis. Debian's MUMPS lacks METIS (ICNTL(7) = 5
+  // falls back to AMF): Metis is METIS_NodeND's ordering, made here. Auto: METIS and QAMD analysed,
+  // fewer estimated flops kept (docs/performance.md, "Defaults and why").
   enum class Ordering { Auto, Metis, Pord, Amd, Amf, Qamd };
   Ordering ordering = Ordering::Auto;
   // ICNTL(14): percentage by which the working space may grow over the
@@ -56,46 +43,21 @@ struct MumpsOptions {
   int workspaceIncreasePercent = -1;
   // MUMPS' own printing (ICNTL(1..4)); silent by default.
   bool verbose = false;
-  // Row and column scaling before each factorisation (ICNTL(8) = 77, MUMPS'
-  // automatic choice) or none (ICNTL(8) = 0). Off: the 3D drive's 422
-  // factorisations (pinch-roller.xml, 2 steps) took 23.6 ms each against
-  // 32.9 ms with scaling, with the same Newton iterations and answers (the
-  // core's rotation 5.5e-12 apart); threshold pivoting still guards the
-  // pivots (tests/integration/direct_solvers.py checks the answers).
+  // Row and column scaling before each factorisation (ICNTL(8) = 77) or none (0). Off: faster, the
+  // same iterations and answers, threshold pivoting still guarding the pivots (docs/performance.md,
+  // "Defaults and why"; tests/integration/direct_solvers.py).
   bool scaling = false;
-  // Matrices with fewer rows than this are gathered onto rank 0 and factored
-  // there alone (MUMPS on a communicator of one, centralised input); larger
-  // ones are factored by all ranks. Time per Newton iteration on 2 ranks,
-  // rank 0 alone against both (docs/performance.md, "Linear solvers"): the
-  // slice (1,926 unknowns) 6.2-6.8 against 7.1-7.4 ms, G1 1x (1,575) 11.5-11.8
-  // against 9.4-9.6 ms, the 3D drive (4,806) 26.1-27.3 against 17.3-19.1 ms
-  // (1 rank: 27.1), the Hertz ring (15,126) 131-143 against 93-99 ms (1 rank:
-  // 150). Below 2,000 it goes either way by up to 20%. 0: always all ranks.
-  // Scene: Solver/Stratimikos/Linear Solver Types/MUMPS/Host Only Below.
+  // Matrices with fewer rows are factored on rank 0 alone, larger ones by all ranks: below 2,000
+  // neither wins clearly (docs/performance.md, "Defaults and why"). 0: always all ranks. Scene:
+  // Solver/Stratimikos/Linear Solver Types/MUMPS/Host Only Below.
   long hostOnlyBelow = 2000;
-  // MUMPS sees only the entries that have been nonzero since the matrix graph
-  // was built (and the diagonal); a zero entry that becomes nonzero joins the
-  // pattern and the analysis is redone. Why: an effect's entity may couple
-  // nodes that only act together where it is active. Steady rolling's friction couples each contact face to the
-  // nodes upstream of it all around the roller, but only the faces in the nip
-  // are active: with every entry the steady 3D drive's factors hold 1.81 M
-  // entries (3.8e8 flops), with the nonzeros 0.68-0.85 M (0.7-1.2e8), and the
-  // steady solve takes 1.55-1.68 s against 2.98 s. The quasi-static drive's
-  // matrix has zeros too (MUMPS' graph: 197,760 edges against 285,602): its
-  // factors 0.68 M entries against 1.10 M, 22.5-25.5 against 27.5-29.1 ms per
-  // Newton iteration. The analyses it adds (4-7 a run, as the contact
-  // zone settles) cost 3-24 ms each (docs/performance.md, "Linear solvers").
-  // Off: the matrix graph's pattern, zeros and all.
+  // MUMPS sees only the entries nonzero since the graph was built, and the diagonal; a new nonzero
+  // redoes the analysis. Entities coupling nodes only where they act (steady friction) stay out of
+  // the factors (docs/performance.md, "Defaults and why"). Off: the graph's pattern.
   bool nonzeroPattern = true;
-  // With nonzeroPattern: the entries of a row in one node's columns (its 3
-  // unknowns) join the pattern together, once any of them is nonzero. A zero
-  // inside a coupled node pair is then an accident of the values (an
-  // undeformed regular mesh's symmetry), not an entity at rest, and its
-  // turning nonzero later need not redo the analysis. capstan sets it with
-  // symmetricPart (no friction): G1 2x one analysis against two, 1.40-1.43
-  // against 1.53-1.62 s on 1 rank, 0.97-1.00 against 1.12-1.27 s on 2. Not
-  // with friction: the steady 3D drive's factors grew from 0.73 to 0.84 M
-  // entries (5 analyses against 7, the same run time).
+  // With nonzeroPattern: a row's entries in one node's 3 columns join the pattern together, so an
+  // undeformed regular mesh's chance zeros do not redo the analysis later. Set with symmetricPart;
+  // with friction the factors grow (docs/performance.md, "Defaults and why").
   bool nonzeroNodeBlocks = false;
   // The factorisation's arithmetic. Single (smumps): half the factors' memory
   // and traffic, a factorisation accurate to about 1e-7 x the condition
@@ -103,13 +65,9 @@ struct MumpsOptions {
   // a solve of its own (the direct solve's factory refuses it).
   enum class Precision { Double, Single };
   Precision precision = Precision::Double;
-  // Factor the symmetric part (A + A^T) / 2 as a symmetric matrix (LDL^T,
-  // SYM = 2): about half the factors' entries and work, and a preconditioner
-  // for GMRES only (not A's solve; the direct solve's factory refuses it).
-  // capstan's frictionless tangents are nearly symmetric (Cauchy stress
-  // 2c(B - I) is not hyperelastic off J = 1: |A - A^T| about 3e-3 of |A| on
-  // G1). Transposes in other ranks' rows are exchanged at each
-  // factorisation. G1 2x: docs/performance.md.
+  // Factor the symmetric part (A + A^T) / 2 in LDL^T (SYM = 2): about half the factors, for a GMRES
+  // preconditioner only (the direct solve refuses it); frictionless tangents are nearly symmetric
+  // (docs/performance.md, "Defaults and why"). Other ranks' transposes are exchanged each time.
   bool symmetricPart = false;
 };
 
@@ -125,12 +83,9 @@ class MumpsSolver {
   MumpsSolver(const MumpsSolver&) = delete;
   MumpsSolver& operator=(const MumpsSolver&) = delete;
 
-  // Factorises A (fill complete, square, row map = domain map = range map, one
-  // to one; any GIDs, contiguous or not). The first call, and any call whose
-  // global sparsity pattern differs from the last one's (with nonzeroPattern:
-  // whose nonzeros are not all in it), runs MUMPS' analysis; otherwise the
-  // analysis is reused and only the numeric factorisation runs.
-  // A must live on the communicator of the first call.
+  // Factorises A (fill complete, square, row map = domain map = range map, one to one; any GIDs) on
+  // the communicator of the first call. MUMPS' analysis runs first and whenever the global pattern
+  // changes (with nonzeroPattern: gains a nonzero); otherwise only the numeric factorisation runs.
   void factor(const CrsMatrix& A);
 
   // Solves A x = b for every column of b (b on A's range map, x on its domain

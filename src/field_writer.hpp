@@ -48,12 +48,9 @@ class FieldWriter {
   FieldWriter(const FieldWriter&) = delete;
   FieldWriter& operator=(const FieldWriter&) = delete;
 
-  // Appends one step. `coordinates` (3 per owned node, current positions) is the
-  // step's geometry. nodal/element/face fields are attributes of the body grid
-  // (nodes, elements) and of the contact-face grid (faces; only if facesGlobal>0).
-  // Collective. After it returns, fields.h5 is flushed and DIR/fields.xmf
-  // (rewritten atomically: temporary name, then rename) indexes every step
-  // written so far, so a run killed later leaves readable files.
+  // Appends one step (collective): `coordinates` (3 per owned node) is its geometry; nodal and
+  // element fields on the body grid, face fields on the faces' (facesGlobal > 0). Then fields.h5 is
+  // flushed and fields.xmf rewritten atomically: a run killed later leaves readable files.
   void writeStep(int step, double time, const std::vector<double>& coordinates,
                  const std::vector<Field>& nodal, const std::vector<Field>& elements,
                  const std::vector<Field>& faces);

@@ -11,18 +11,13 @@ namespace {
 // The smallest sub-step, as a fraction of Time/Step Size (in steady rolling, of
 // the loads' ramp left at the step's start where that is shorter): ten halvings.
 constexpr double kMinimumSubstep = 1.0 / 1024;
-// Coulomb's solves may go on in pseudo-time while points stick in sub-steps of
-// at most this fraction of the step (three cuts): where sticking points make
-// the answer depend on the path, the pseudo-time path strays from the load
-// path by about the sub-step. G1 dragged by a turning capstan (mu 0.9-1.6)
-// failed at the smallest sub-step without it (docs/friction.md).
+// Coulomb goes on in pseudo-time while points stick only in sub-steps up to this fraction of the
+// step: the answer then depends on the path, and pseudo-time strays from it by about the sub-step
+// (docs/friction.md, "G1 dragged by a turning capstan: pseudo-time in short sub-steps").
 constexpr double kPseudoTimeWithStickSubstep = 1.0 / 8;
-// Cuts in one step before it fails: a step whose sub-steps fail, pass at half
-// the size, grow and fail again creeps on (the sweep's steady slice with a
-// contact penalty of 2.9, 290x formulation.md's softest, cut 47 times in its
-// first minute at 3.5e-8 of a 3.5e-5 ramp). Ten halvings reach the smallest
-// sub-step; today's converging runs in docs/ cut at most 19 times in a whole run
-// (H4 once needed 37 in its step 2, before the pseudo-time fallback).
+// Cuts in one step before it fails: sub-steps that pass at one size and fail at twice it would
+// creep on; ten halvings reach the smallest sub-step, and converging runs need far fewer cuts
+// (docs/numerics.md, "Load steps").
 constexpr int kMostCutsPerStep = 40;
 
 // How long after t the cores' external loads (forces, torques) still ramp: 0

@@ -40,14 +40,9 @@ class MeshGenerator {
   virtual GO ringNeighbour(GO /*node*/, int /*step*/) const { return -1; }
 };
 
-// How elements are split over the ranks.
-// - Metis: METIS k-way on the dual graph (fewest faces cut, any mesh).
-// - Slabs: equal runs of consecutive element ids. Both generators number
-//   their cells with the third index slowest, so the runs are slabs across
-//   it (a box's z, an annulus's axis). Each rank's nodes are then a run of
-//   the one-rank numbering, and MueLu's aggregation, which walks the nodes in
-//   that order, makes nearly the aggregates it makes on one rank
-//   (docs/performance.md, "Partitions").
+// How elements are split over the ranks: Metis (k-way on the dual graph, any mesh) or Slabs (equal
+// runs of element ids: slabs across the slowest index, so each rank's nodes run as on one rank and
+// MueLu aggregates nearly as there; docs/performance.md, "Partitions").
 enum class Partition { Metis, Slabs };
 
 // Mesh/Partition = Auto: Slabs on several ranks where each rank's slab is at
@@ -79,19 +74,9 @@ class BoxGenerator : public MeshGenerator {
   std::array<GO, 3> ijk(GO element) const;
 };
 
-// Hollow cylinder along +z (the rubber coating of a pinch roller): Cells =
-// {radial, circumferential, axial} bricks between Inner and Outer Radius, from
-// Center (the axis point at the zmin end) over Length. Closed around the
-// circumference (nodes at angle 2 pi are those at 0). Faces inner, outer,
-// zmin, zmax. Brick axes (radial, circumferential, axial) are right-handed, so
-// every brick has a positive Jacobian.
-//
-// Grading, so that the part of the coating that passes through the nip is fine
-// and the rest coarse: radially, the cells' thickness changes geometrically from
-// the inner to the outer face by outerCellRatio (< 1: thinner at the outer
-// face); around the circumference, sector = {centre angle, width (degrees, from
-// +x towards +y), fraction of the circumferential cells placed in it} (width 0:
-// uniform).
+// Hollow cylinder (a pinch roller's coating) along +z from Center, its zmin axis point: cells
+// {radial, circumferential, axial}, right-handed, closed around; faces inner, outer, zmin, zmax.
+// Graded for the nip: outerCellRatio (< 1: thin outside); sector {centre, width (deg), fraction}.
 class AnnulusGenerator : public MeshGenerator {
  public:
   AnnulusGenerator(std::array<double, 3> center, double innerRadius, double outerRadius, double length,

@@ -73,12 +73,9 @@ class MumpsSolveFactory : public MumpsParameters<Thyra::LinearOpWithSolveFactory
   std::string description() const override { return "capstan::MumpsSolveFactory"; }
 };
 
-// A MUMPS factorisation as a preconditioner (Stratimikos' "Preconditioner
-// Type" = "MUMPS"): GMRES on Newton's matrix with the LU of an earlier one.
-// Newton's matrices change little from one iteration to the next, so a
-// factorisation kept over several iterations (Solver/Preconditioner Reuse)
-// still makes GMRES converge in a few iterations, each a pair of triangular
-// solves, much cheaper than a new factorisation (docs/performance.md).
+// A MUMPS factorisation as a preconditioner (Stratimikos' "MUMPS"): GMRES on Newton's matrix with
+// an earlier one's LU, kept (Solver/Preconditioner Reuse) since Newton's matrices change little: a
+// few iterations of two triangular solves each cost less than a factorisation.
 class MumpsPreconditionerFactory : public MumpsParameters<Thyra::PreconditionerFactoryBase<double>> {
  public:
   bool isCompatible(const Thyra::LinearOpSourceBase<double>& fwdOpSrc) const override;

@@ -36,30 +36,13 @@ class NewtonSolver {
   // Solves R(u) = 0 from the initial guess u (updated in place) until
   // |R| <= tolerance.
   NewtonResult solve(Vector& u, double tolerance);
-  // Pseudo-transient continuation (Kelley and Keyes, SIAM J. Numer. Anal. 35,
-  // 1998) from u (updated in place) until |R| <= tolerance: Newton steps with
-  // D / dtau added to the tangent's diagonal (D = |diag W|), every step that
-  // neither inverts an element nor multiplies |R| by 10 accepted, dtau
-  // doubled after a step that kept |R| within 1.5x and did not turn back on
-  // the last one (a cycle across a kink), else halved. Small dtau follows the
-  // flow du/dtau = -D^-1 R(u),
-  // which moves along the unbalanced force rather than down |R|: it crosses a
-  // region where |R| rises on the way to the root, which Newton's line search
-  // cannot, and it stays stable where the tangent is indefinite (a soft body
-  // dragged by friction whose force grows faster than its support's; docs/
-  // friction.md, "What step 2 is"). Large dtau is Newton's step. A fallback
-  // for a failed solve (src/augmentation.cpp); stepLengths holds dtau.
+  // Pseudo-transient continuation (Kelley and Keyes 1998) to |R| <= tolerance: Newton with
+  // |diag W| / dtau on the diagonal. Small dtau follows the force across rising |R| and indefinite
+  // tangents, where the line search stalls; a failed solve's fallback. stepLengths: dtau.
   NewtonResult pseudoTransient(Vector& u, double tolerance);
-  // One linear solve W x = b with Newton's matrix W = matrix(), as the caller
-  // assembled it, and the configured solver with a preconditioner of its own
-  // (x: initial guess in, solution out), to the relative residual `tolerance`
-  // (Krylov solvers). Newton reassembles W before it next solves.
-  // `preconditioner`: Own (a new one), Kept (the one Newton keeps, Solver/
-  // Preconditioner Reuse; built now if none is or a rebuild is due) or
-  // KeptAsBuilt (the one Newton keeps as it is, however old: keepsFactorisation()
-  // says whether there is one). `maxIterations` > 0: at most that many Krylov
-  // iterations (fewer than the scene's limit).
-  // Returns the Krylov iterations, or -1 if it failed.
+  // One solve W x = b with matrix() as the caller assembled it (x: guess in, answer out), to the
+  // relative `tolerance`, at most `maxIterations` if > 0: Krylov iterations, -1 on failure. Own: a
+  // new preconditioner; Kept: Newton's, built if due; KeptAsBuilt: Newton's as it is.
   enum class Preconditioner { Own, Kept, KeptAsBuilt };
   int linearSolve(const Vector& b, Vector& x, double tolerance, Preconditioner preconditioner = Preconditioner::Own,
                   int maxIterations = 0);
@@ -71,12 +54,9 @@ class NewtonSolver {
   void rebuildPreconditioner();
   // Newton's matrix (values: whatever was last assembled into it).
   RCP<FEMatrix> matrix() const;
-  // z = K~^-1 r, an approximate inverse of matrix() as its values are now:
-  // Newton's preconditioner (built if it has none yet), or, for a direct
-  // solver, a factorisation made once here, or with `afterNewton` (matrix()
-  // assembled where a Newton solve just converged) the one Newton made last,
-  // one Newton step before. Building it counts as linear solve time (set-up
-  // as preconditioner set-up); its applications are the caller's to time.
+  // z = K~^-1 r for matrix() as it is now: Newton's preconditioner (built if none), or for a direct
+  // solver a factorisation made here, or with `afterNewton` Newton's last (one Newton step old).
+  // Its set-up counts as linear solve time; its applications are the caller's to time.
   std::function<void(const Vector& r, Vector& z)> approximateInverse(bool afterNewton = false);
   double linearSolveSeconds() const;
   // A failure that may be this rank's alone (a solver's exception), agreed

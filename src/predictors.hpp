@@ -17,11 +17,9 @@ namespace capstan {
 class Predictors {
  public:
   Predictors(Model& model, Log& log) : m_(model), log_(log) {}
-  // Moves u from the converged state at t0 to a first guess of the state at
-  // t1 (constraints applied at t1). Returns the residual norm of the bare
-  // increment (u with only the prescribed values moved): a guess is kept only
-  // where it beats it, and Newton's tolerance is relative to it. The
-  // predictor's Krylov iterations count in rec.
+  // Moves u from the converged state at t0 to a first guess at t1 (constraints at t1). Returns the
+  // bare increment's residual (only prescribed values moved): a guess must beat it, and Newton's
+  // tolerance is relative to it. Krylov iterations count in rec.
   double firstGuess(double t0, double t1, StepRecord& rec);
   // The state before the increment that just converged (u, its time and the
   // cores' rotations): the base of the rolling extrapolation.

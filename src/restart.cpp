@@ -21,11 +21,9 @@ std::vector<double> hostValues(const Kokkos::View<double*>& v) {
   return std::vector<double>(h.data(), h.data() + h.size());
 }
 
-// Node ids of each entity of effect e (nodes per entity in `perEntity`): the
-// keys that put each saved value back where it was taken from. A block of
-// dofs past the mesh's nodes (a rigid core's: steady friction's angular
-// velocity) is keyed -1 - its place after them, the same in every run of
-// the scene on as many ranks.
+// Node ids of each entity of effect e (perEntity of them): the keys that put each saved value back.
+// Dofs past the mesh's nodes (a rigid core's: steady friction's omega) get -1 - their place after
+// them, the same in every run of the scene on as many ranks.
 std::vector<long long> entityKeys(const Mesh& mesh, const Effect& e, int& perEntity) {
   auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), e.local().dofs);
   perEntity = int(dofs.extent(1) / 3);

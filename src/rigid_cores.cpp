@@ -128,11 +128,9 @@ void RigidCores::assembleCoupling(FEMatrix& W, const std::vector<std::unique_ptr
                                   const std::vector<TangentSink>& sinks, const std::vector<LO>& columnOf,
                                   const Constraints& constraints) {
   if (cores_.empty()) return;
-  // The chain rule for u_s = T + (R(theta) - I)(X_s - A) at each face node s,
-  // with B_s = du_s/dq = [I | b_s]: element entries K(k, s) go to K(k, q) B_s,
-  // K(s, l) to B_s^T K(s, l), K(s, s') to B_s^T K B_s'; and
-  // d(sum_s R_s . b_s)/dtheta adds sum_s R_s . w_s to (theta, theta).
-  // Accumulated per element in dense arrays, then added row by row.
+  // Chain rule for u_s = T + (R(theta) - I)(X_s - A), B_s = du_s/dq = [I | b_s]: K(k, s) -> K(k, q)
+  // B_s, K(s, l) -> B_s^T K(s, l), K(s, s') -> B_s^T K B_s', and sum_s R_s . w_s to (theta, theta),
+  // from d(sum_s R_s . b_s)/dtheta; per element in dense arrays, then row by row.
   const auto& supportOf = constraints.supportOf;
   const size_t nc = cores_.size(), nq = 4 * nc;
   const int nodeDofs = layout_.nodeDofs;

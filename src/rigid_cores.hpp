@@ -24,12 +24,9 @@ namespace capstan {
 struct Scene;
 class Constraints;
 
-// A rigid core (SupportSpec type Rigid Core) as the assembly keeps it: its
-// unknowns q = (T, theta) are global dofs owned by rank 0; its face's nodes
-// are eliminated (u = T + (R(theta) - I)(X - A), kernels/rigid_core.hpp).
-// In steady rolling (formulation.md §8) the mesh does not turn: the fourth
-// unknown is the angular velocity omega, the face nodes sit at X + T, and
-// omega's equation is still the torque balance (the reactions' moment).
+// A rigid core as the assembly keeps it: unknowns q = (T, theta), global dofs on rank 0; face nodes
+// eliminated (u = T + (R(theta) - I)(X - A), kernels/rigid_core.hpp). Steady rolling
+// (formulation.md §8): the mesh stands, face nodes at X + T, 4th unknown omega (torque balance).
 struct RigidCore {
   std::string name;
   std::array<double, 3> axisPoint{}, axisDirection{}, force{};

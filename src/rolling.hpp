@@ -21,11 +21,9 @@ double noSlipAngularVelocity(const Scene& scene, const RigidCore& core);
 // what friction in the nip can carry ("; support ...: ..."), or empty.
 std::string brakeDiagnosis(const Scene& scene);
 
-// What to try where a rolling step (an annulus, steady or quasi-static) under
-// Coulomb's exact stick stalled (failure: the attempt's reason): stick and
-// slip can chatter from pass to pass on a nip of many fine cells over a thick
-// outer cell, where a Tanh law or more radial cells converge
-// (docs/steady-rolling.md, "Stick and slip that cycle"); or empty.
+// What to try where a rolling step on an annulus under Coulomb's exact stick stalled (failure: its
+// reason), or empty: stick and slip can chatter on a fine nip over a thick outer cell, where a Tanh
+// law or more radial cells converge (docs/steady-rolling.md, "Stick and slip that cycle").
 std::string stickChatterHint(const Scene& scene, const std::string& failure);
 
 }  // namespace capstan

@@ -7,12 +7,9 @@
 namespace capstan {
 
 namespace {
-// Each row's diagonal gets this fraction of its Schur approximation w_j S_j
-// added: a node's stick (and contact) condition comes once from each face at
-// it, so those rows repeat and the block matrix is singular (MUMPS: INFOG(1) =
-// -10 on the steady drive's first Coulomb pass). GMRES removes the difference:
-// on the steady drive 1-2 iterations a step at 1e-8 to 1e-4 (1e-2: 2-3), the
-// same Newton iterations and speed ratio.
+// Each row's diagonal gets this fraction of its Schur approximation w_j S_j: a node's stick and
+// contact rows come once from each face at it, so they repeat and the block matrix is singular;
+// GMRES removes the difference (docs/numerics.md, "The pressure loop").
 constexpr double kRegularisation = 1e-6;
 constexpr int kWorkspaceIncreasePercent = 100;
 }  // namespace

@@ -41,11 +41,9 @@ const std::set<std::string> kPassThrough = {"NOX", "Stratimikos", "Belos", "Ifpa
 // The softest end of formulation.md's contact penalties, eps2 in [1e-15, 1e-2]:
 // above it, a warning.
 constexpr double kLargestContactPenalty = 1e-2;
-// Tanh and Arctan with a slip speed scale below this fraction of the capstan's
-// surface speed are solved as their limit, Coulomb: there the regularised law
-// holds its sticking points to round-off it cannot resolve (exit 2 on the
-// transient slice from 1e-7, on H5 from 2e-7; docs/friction.md, "Tiny
-// regularisation"), and it lies within about 1e-6 of Coulomb's answer.
+// Tanh and Arctan with a slip speed scale below this fraction of the capstan's surface speed are
+// solved as their limit, Coulomb: round-off cannot resolve their sticking points' slip
+// (docs/friction.md, "The floor: below 3e-7 of the capstan's speed, the law's limit").
 constexpr double kFinestSlipSpeedScale = 3e-7;
 
 Array<double> vec3(double a, double b, double c) { return Teuchos::tuple(a, b, c); }
@@ -399,14 +397,9 @@ double convexMinimum(F f, double lo, double hi) {
   return std::min({f(lo), f(hi), fc, fd});
 }
 
-// A capstan that can never touch its contact faces is most likely a typo in
-// Axis Point or Radius. Conservative: the faces' bounding box is enlarged by
-// the body's largest extent (however it deforms) plus the farthest any
-// Displacement support moves over the run, and the capstan's axis is followed
-// over the whole run (the axis point moves with Velocity until Steps x Step
-// Size). Only when even that box stays farther than Radius from every axis
-// position is the input flagged. The distance from a box to a line, and its
-// minimum over the axis' travel, are convex in the line's parameter and in t.
+// A capstan that can never touch its contact faces is most likely a typo in Axis Point or Radius.
+// Flagged only if the faces' box, enlarged by the body's extent and the supports' travel, stays
+// farther than Radius from the axis over its whole travel (a distance convex in t).
 void warnUnreachable(Scene& sc, const CapstanSpec& c) {
   const auto& m = sc.mesh;
   const double T = sc.steps * sc.stepSize;
@@ -548,13 +541,9 @@ std::vector<std::string> splitNames(const std::string& s) {
   return names;
 }
 
-// Accuracy presets (docs/accuracy.md). The measured studies show the mesh is the
-// knob that sets the error of every quantity of interest (load steps, penalties
-// with the augmented Lagrangian and the Newton tolerance below 1e-6 change the
-// answers by less than 1e-9), so a preset scales Mesh/Cells; Draft instead keeps
-// the mesh and loosens the Newton tolerance, which costs no accuracy worth
-// measuring and about a third of the time. Applied to the user's list before
-// defaults are filled in, so solver parameters the scene (or --set) names win.
+// Accuracy presets (docs/accuracy.md, "Accuracy presets"): the mesh sets the error, so a preset
+// scales Mesh/Cells; Draft keeps the mesh and loosens the Newton tolerance. Applied before defaults
+// are filled in, so solver parameters the scene (or --set) names win.
 void applyAccuracyPreset(ParameterList& user, const Validator& v) {
   if (!user.isType<std::string>("Accuracy")) return;  // absent, or a type error check() reports
   const std::string preset = user.get<std::string>("Accuracy");
@@ -581,11 +570,9 @@ void applyAccuracyPreset(ParameterList& user, const Validator& v) {
 
 }  // namespace
 
-// Numbers far outside any physical scale (c = 1e300, a Radius of 1e300, a
-// Length of 1e-300) overflow or vanish in the products the kernels form and
-// left NaN in the outputs: capstan computes with non-zero magnitudes between
-// kSmallest and kLargest (the shipped scenes and tests use 1e-15 to 1e3).
-// Directions are scaled to unit length first, whatever their size.
+// Non-zero magnitudes capstan computes with (the shipped scenes and tests use 1e-15 to 1e3): far
+// beyond, the kernels' products overflow or vanish (c = 1e300 left NaN in the outputs). Directions
+// are scaled to unit length first, whatever their size.
 constexpr double kSmallest = 1e-25, kLargest = 1e25;
 
 static void rejectMagnitudesOutOfRange(const ParameterList& list, const std::string& path, const Validator& v) {

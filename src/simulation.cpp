@@ -16,11 +16,9 @@ namespace capstan {
 
 namespace {
 
-// Below this smallest Gauss-point det F at the last converged state, a failed
-// run says where its mesh is most distorted: G1 pressed to 0.9 of its 1.75
-// height converged there with 0.48 (principal stretch 0.23 at the capstan's
-// edge) and 0.10 on the 2x mesh (0.05 at the bonded base's edge), and neither
-// went on to 1.0; at its own 0.5 it ends with 0.83.
+// Below this smallest Gauss-point det F at the last converged state, a failed run says where its
+// mesh is most distorted: G1's deepest converged indentation ends below it, and the next step
+// fails (docs/numerics.md, "How deep an indentation goes").
 constexpr double kDistortedDetF = 0.5;
 
 std::string distortionNote(const BrickEffect::Compression& c) {

@@ -42,25 +42,18 @@ struct SolverSettings {
   double volumeTolerance = 0;
   int maxPressureIterations = 0;
   PressureUpdate pressureUpdate{};
-  // Pressure Update = Monolithic (Auto without friction): each pass of the
-  // pressure loop is one saddle-point step from where the last left off, with
-  // no Newton solve on the positions alone in between (src/augmentation.cpp).
-  // Auto's only where the step's K^-1 is exact (a direct solver or the LU
-  // preconditioner; Model decides, knowing the linear solver).
+  // Pressure Update = Monolithic (Auto without friction): each pass one saddle-point step from the
+  // last, no Newton solve between (src/augmentation.cpp). Auto's only where the step's K^-1 is
+  // exact (a direct solver or the LU preconditioner; Model decides).
   bool monolithic = false;
   bool monolithicIfExact = false;
   Schur pressureStepSchur{};
   // With a direct solver, the saddle-point step after a Newton solve
   // preconditions with Newton's last factorisation (false: a new one).
   bool pressureStepOnNewtonsFactors = true;
-  // The saddle-point step's GMRES preconditioner: block-triangular (K^-1 and
-  // the Schur approximation) or the whole block matrix factored by MUMPS
-  // (src/saddle_point_lu.hpp); Auto: the factored matrix for steady rolling
-  // above kStepLUAboveDofs unknowns where Newton's solves factor the matrix
-  // (direct, or the LU preconditioner). Its factorisation costs 20-40 GMRES
-  // iterations of the block one: the shipped drive (4,806 unknowns, 3-14 a
-  // step) 0.95 against 0.88 s; its fine nips (10,000-17,000 unknowns, 50-2,000
-  // a step) 1.3-8x faster where they converge with it (docs/performance.md).
+  // The saddle-point step's GMRES preconditioner: block-triangular (K^-1, the Schur approximation)
+  // or the whole block matrix factored (src/saddle_point_lu.hpp). Auto: factored for steady rolling
+  // above kStepLUAboveDofs where Newton factors (docs/performance.md, "Defaults and why").
   StepPreconditioner pressureStepPreconditioner{};
   static constexpr long kStepLUAboveDofs = 10000;
   int pressureAccelerationDepth = 0;

@@ -52,13 +52,9 @@ ContactSettings ContactSettings::parse(const Teuchos::ParameterList& ct, const s
   return s;
 }
 
-// A stiff penalty gets the nodal rule: Gauss points of flat faces on a curved
-// capstan over-constrain them as eps2 -> 0, and the pressure loop stalls: G1 at
-// eps2 = 1e-5 took 75 s and 19 cuts, at 1e-6 it failed (docs/contact.md, "Stiff
-// penalties"); nodal, both in 20 Newton iterations.
-// Exact stick with Gauss points has no stick rows in the saddle-point step,
-// and the multiplier loop crawls: the steady slice under Coulomb with a contact
-// Penalty of 1e-2 failed (6e-3: 85 Newton iterations); nodal, 13 (0.066: 11).
+// Nodal for the augmented Lagrangian, a stiff penalty and Coulomb's exact stick: Gauss points of
+// flat faces over-constrain the curved capstan as eps2 -> 0, and stick rows exist only at nodal
+// points (docs/contact.md, "Contact points: Gauss or nodal").
 ContactSettings::Quadrature ContactSettings::resolvedQuadrature(double hMin, double c, bool exactStick) const {
   if (quadrature != Quadrature::Auto) return quadrature;
   return exact() || exactStick || penalty < kGaussPenaltyLimit * hMin / c ? Quadrature::Nodal : Quadrature::Gauss2x2;

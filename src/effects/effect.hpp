@@ -45,24 +45,17 @@ inline Kokkos::View<int*>::HostMirror activeOnHost(const LocalSystem& L) {
   return Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), L.active);
 }
 
-// What a kernel does with an active entity's tangent K_e (n x n, row-major,
-// dof 3a+i) right after forming it, while it is still in cache. Element
-// tangents are not stored: on G1 8x on one rank they took 790 MB, and the run's
-// peak fell 18% without them (docs/performance.md, "Assembly without stored
-// element tangents"). Each part is off when empty:
-//   - values: K_e is added into the local CRS values of Newton's matrix (owned
-//     plus shared rows) at offsets found once: rowBlock(e, k * n/3 + b) is the
-//     offset of column 3b in row k (its 3 columns follow it), -1 where row k
-//     is held; bit l of heldColumns(e) set: column l is held, not added;
-//   - z, Kz: Kz(e, k) = sum_l K_e(k, l) z(e, l), the step predictor's K z;
-//   - keepSlot, kept: a copy of K_e in kept(keepSlot(e)) where keepSlot(e) >= 0
-//     (entities with a rigid core's face node, for the chain rule).
+// What a kernel does with an active entity's tangent K_e (n x n, row-major) while it is in cache:
+// adds it into Newton's CRS values, forms the predictor's K z, keeps a copy; empty parts are off
+// (docs/performance.md, "Assembly without stored element tangents").
 struct TangentSink {
-  Kokkos::View<double*> values;
+  Kokkos::View<double*> values;  // Newton's local CRS values (owned and shared rows)
+  // rowBlock(e, k * n/3 + b): offset of column 3b in row k (-1: row k held); bit l of heldColumns(e):
+  // column l held, not added.
   Kokkos::View<int**, Kokkos::LayoutRight> rowBlock;
   Kokkos::View<int*> heldColumns;
-  Matrix z, Kz;
-  Kokkos::View<int*> keepSlot;
+  Matrix z, Kz;                 // Kz(e, k) = sum_l K_e(k, l) z(e, l)
+  Kokkos::View<int*> keepSlot;  // >= 0: K_e copied to kept(keepSlot(e)) (a rigid core's face node)
   Kokkos::View<double***, Kokkos::LayoutRight> kept;
 
   // Entity e's tangent K (n x n): into the matrix, K z and the kept copy.
@@ -100,14 +93,9 @@ struct TangentSink {
   }
 };
 
-// An effect's constraints, linearised at the last evaluation, for the
-// saddle-point step (src/pressure_step.hpp), which solves for the position
-// change and the multipliers' changes together. Row j, multiplier mu_j:
-//     c_j(x + dx, mu_j + dmu_j) ~ c_j + gradient_j . dx + diagonal_j dmu_j = 0,
-//     dR / dmu_j = force_j gradient_j,
-// and schur_j approximates the Schur complement's diagonal
-// diagonal_j - force_j gradient_j^T K^-1 gradient_j: Newton's K holds each
-// constraint's penalty, which makes that diagonal approximation good.
+// An effect's constraints linearised for the saddle-point step (src/pressure_step.hpp). Row j,
+// mu_j: c_j + gradient_j . dx + diagonal_j dmu_j = 0, dR/dmu_j = force_j gradient_j; schur_j ~
+// diagonal_j - force_j gradient_j^T K^-1 gradient_j, good as K holds each constraint's penalty.
 struct ConstraintRows {
   std::vector<int> entity;      // row j's entity (its dofs: local().dofs(entity_j, .))
   std::vector<int> multiplier;  // mu_j's index in multipliers()
@@ -155,11 +143,9 @@ class Effect {
   // tEnd: effects that move with time (capstans) evaluate at tEnd.
   virtual void setInterval(double /*tStart*/, double /*tEnd*/) {}
 
-  // Augmentation, the outer loop around each Newton solve (element pressure
-  // anchors, contact multipliers): the multipliers are held fixed in a Newton
-  // solve; after it converges they move to their fixed-point map G, until each
-  // effect's constraint violation is within its tolerance. Effects without
-  // multipliers return an empty view.
+  // Augmentation, the outer loop around each Newton solve: the multipliers (pressure anchors,
+  // contact) are held in a solve, then move to their fixed-point map G, until every effect's
+  // violation is within its tolerance. Effects without multipliers return an empty view.
   virtual Kokkos::View<double*> multipliers() { return {}; }
   // G(multipliers) at the last evaluation, into `next` (same size).
   virtual void multiplierMap(const Kokkos::View<double*>& /*next*/) const {}

@@ -32,22 +32,18 @@ class FrictionEffect : public Effect {
   // Tanh and Arctan: the capstan surface's travel over the slip scale v
   // (scale 1), (|omega| R + |velocity|) / eps3, independent of dt; 0 otherwise.
   double travelOverSlipScale() const;
-  // Tanh and Arctan: the residual's round-off floor at the last evaluation,
-  // over all ranks. A slip is known to about eps |x| (positions of size |x|),
-  // and at zero slip the law's slope is mu t_n / v: a law so steep that
-  // w mu t_n eps |x| / v passes Newton's tolerance stalls there (G1 under
-  // Tanh at eps3 = 1e-6: |R| 1e-10 to 1e-9). 0 for the other laws.
+  // Tanh, Arctan: the residual's round-off floor at the last evaluation (all ranks), eps |x| times
+  // the slope mu t_n / v: where it passes Newton's tolerance the solve stalls (0 for other laws;
+  // docs/friction.md, "Above the floor: the steep law's round-off as the later passes' tolerance").
   virtual double residualRoundOff(const Teuchos::Comm<int>& comm) const;
   // Predictor: every contact point sticks (kernels/friction.hpp).
   void setPredicting(bool on) override { parameters_.stickPredictor = on; }
   Kokkos::View<double*> history() override { return history_; }
   void commit(const NodalVectors& x) override;
 
-  // Coulomb with the augmented Lagrangian contact: a tangential multiplier per
-  // point replaces last step's traction in the trial traction and is updated
-  // to the traction after each converged solve (Uzawa), so sticking points
-  // stick exactly (no elastic slip of size eps_t t) whatever the tangential
-  // penalty. Violation: eps_t |t - lambda_T|, the slip of a sticking point.
+  // Coulomb with augmented Lagrangian contact: a tangential multiplier per point replaces last
+  // step's traction in the trial traction and moves to the traction after each solve (Uzawa):
+  // sticking points stick exactly whatever eps_t. Violation: eps_t |t - lambda_T|.
   virtual bool augmented() const {
     return settings_.law == FrictionSettings::Law::Coulomb && contact_.settings().exact();
   }
@@ -60,12 +56,9 @@ class FrictionEffect : public Effect {
   int multiplierSites(std::vector<int>& nodes) const override {
     return augmented() ? contact_.multiplierSites(nodes) : 0;
   }
-  // Coulomb's sticking points in the saddle-point step (src/pressure_step.hpp):
-  // the slip c = tau . du_t along the capstan's two tangents tau (b x e and the
-  // axis b), with the stick traction's component along tau as multiplier. At
-  // stick t = P_t lambda_T + du_t / eps_t, so dR/dmu = -w N tau = w dc/dx to
-  // the slip's curvature terms (spin / R), and the Schur diagonal is -eps_t.
-  // Without these rows the plain update lambda_T <- t gains only 1.3-2x a pass.
+  // Coulomb's sticking points in the saddle-point step: the slip c = tau . du_t along b x e and the
+  // axis b, multiplier the stick traction along tau, dR/dmu = -w N tau, Schur diagonal -eps_t; the
+  // plain update gains only 1.3-2x a pass (docs/friction.md, "The multiplier loop in rolling").
   void constraintRows(const NodalVectors& x, ConstraintRows& rows) const override;
   // Rows only at the nodal rule's points (one per face node, as exact contact
   // has): with Gauss points, 2 rows per point outnumber the nodes' tangential
@@ -73,16 +66,9 @@ class FrictionEffect : public Effect {
   bool stepsForItself() const override {
     return augmented() && parameters_.smoothing == 0 && contact_.rule() == kernels::FaceRule::Nodal;
   }
-  // Coulomb with the stick rows: after each pass's Newton solve, a point whose
-  // stick/slip state has gone A, B, A, B, A over five passes (the multiplier loop
-  // cycling at the stick zone's edge, where |t| = mu t_n to within the step's
-  // reach) is held in slip, at the cone, for the rest of the solve, where the
-  // loop has stopped making progress (mayHold); with lastResort (it has not
-  // for longer), any point whose state has changed four times or more in the
-  // solve too. With freeze (longer still), every other point in contact is
-  // held in the state it has, and a point held in stick goes into slip (for
-  // good) once its traction leaves the cone: the states can only move one way,
-  // so they settle. Released at the next solve. True where a hold changed.
+  // Where the multiplier loop stopped gaining, holds states so they settle: mayHold, a point
+  // cycling A, B, A, B, A in slip at the cone; lastResort, any changed 4+ times; freeze, all others
+  // as they are (stick till it leaves the cone). Released at the next solve. True: a hold changed.
   bool notePass(bool mayHold, bool lastResort, bool freeze);
   long heldPoints() const { return heldPoints_; }
   void releaseHeldSlips();
@@ -137,11 +123,9 @@ class FrictionEffect : public Effect {
   std::vector<PointCycle> cycles_;  // [face * kMaxFacePoints + q]
   long heldPoints_ = 0;
   static constexpr int kHistoryPerFace = 12 + 3 * kernels::kMaxFacePoints;
-  // Coulomb's sticking points, two rows each (constraintRows): the value,
-  // multiplier, force, Schur diagonal and direction of each row into rows;
-  // fill(f, N, e, tau, circumferential, g) writes a row's gradient over the
-  // entity's `width` dofs into g (zeroed); grad and column get every row's
-  // gradient and dR/dmu (-w N_a tau on the face's nodes), row after row.
+  // Coulomb's sticking points, two rows each (constraintRows): value, multiplier, force, Schur
+  // diagonal, direction into rows; fill(f, N, e, tau, circumferential, g) writes a row's gradient
+  // over `width` dofs into g (zeroed); grad and column get every row's gradient and dR/dmu.
   using StickRowFill =
       std::function<void(size_t f, const double N[4], const double* e, const double tau[3], bool circumferential,
                          double* g)>;

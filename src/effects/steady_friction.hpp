@@ -41,23 +41,16 @@ class SteadyFrictionEffect : public FrictionEffect {
   double residualRoundOff(const Teuchos::Comm<int>&) const override { return 0; }
   bool accelerated() const override { return true; }
   int multiplierSites(std::vector<int>&) const override { return 0; }  // the mesh stands still: no shift
-  // Coulomb's sticking points in the saddle-point step, as in the quasi-static
-  // analysis (FrictionEffect::constraintRows), but the slip spans the face's
-  // entity: c = tau . du_t with du = spin tau_c - sum_a N_a flow tau_f
-  // (dx/dtheta)_a, so dc/dx_k = -flow sum_a N_a W_ak tau and dc/domega =
-  // -dflow sum_a N_a tau . travel_a, while the traction acts on the face's
-  // nodes only (ConstraintRows::column: -w N_a tau).
+  // Stick rows as FrictionEffect's, but the slip spans the entity, the traction the face's nodes:
+  // du = spin tau_c - sum_a N_a flow tau_f (dx/dtheta)_a, so dc/dx_k = -flow sum_a N_a W_ak tau and
+  // dc/domega = -dflow sum_a N_a tau . travel_a (ConstraintRows::column: -w N_a tau).
   void constraintRows(const NodalVectors& x, ConstraintRows& rows) const override;
   // Steady rolling's start: friction off (a frictionless footprint first).
   void setEnabled(bool on) { enabled_ = on; }
   bool acting() const override { return enabled_; }
-  // Steady rolling's start from rest (src/steady_rolling.cpp): a wider law in
-  // the scene's place, of slip speed scale (Friction/Regularization)
-  // `speedFraction` of the capstan's surface speed (so the start does not
-  // depend on the speed): Tanh in Coulomb's place, or the scene's Tanh or
-  // Arctan with that scale. useSceneLaw() ends it: the scene's law again,
-  // Coulomb's multipliers where `seed` the last evaluation's tractions (else
-  // they are left as they are).
+  // Steady rolling's start from rest: a wider law in the scene's (Tanh for Coulomb), slip speed
+  // scale `speedFraction` of the capstan's surface speed, so the start does not depend on the
+  // speed. useSceneLaw() ends it; `seed`: Coulomb's multipliers from the last tractions.
   void useStartLaw(double speedFraction);
   void useSceneLaw(bool seed);
   // The scene's slip speed scale over the capstan's surface speed; 0 under Coulomb.
