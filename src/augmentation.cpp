@@ -338,8 +338,8 @@ bool AugmentationLoop::checkConstraints(int it, StepRecord& rec, Constraints& c,
     c.met = false;
     c.rowsUnmet = c.rowsUnmet || e->stepsForItself();
     if (e->maxAugmentations() > 0 && it >= e->maxAugmentations()) {
-      failure = e->constraintName() + " " + Teuchos::toString(v) + " above its tolerance " +
-                Teuchos::toString(e->constraintTolerance()) + " after " + std::to_string(it) + " augmentations";
+      failure = format("%s %.4g above its tolerance %.4g after %d augmentations", e->constraintName().c_str(), v,
+                       e->constraintTolerance(), it);
       return false;
     }
   }

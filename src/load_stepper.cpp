@@ -90,7 +90,9 @@ bool LoadStepper::advance(StepRecord& rec, std::string& failure) {
     // of a 1e-3 s step: half the force first; docs/steady-rolling.md).
     const double rampLeft = steady ? loadRampLeft(assembly, tDone_) : 0;
     if (rampLeft > 0 && h >= rampLeft) h = rampLeft / 2;
-    log_.progress(format("  step %d: cut back to dt = %.4g (%s)", rec.step, h, why.c_str()));
+    // How much of the step is done: a run of cuts to the same dt is then seen to advance.
+    log_.progress(format("  step %d, %.3g of it done: cut back to dt = %.4g (%s)", rec.step,
+                         (tDone_ - tStep) / (rec.time - tStep), h, why.c_str()));
     const std::string hint = chatterHinted_ ? std::string() : stickChatterHint(m_.scene, why);
     if (!hint.empty()) {
       chatterHinted_ = true;  // once a run: the hint, before the cuts' retries
@@ -98,7 +100,7 @@ bool LoadStepper::advance(StepRecord& rec, std::string& failure) {
     }
     if (h < minimumSubstep || rec.cutbacks > kMostCutsPerStep) {
       failure = "step " + std::to_string(rec.step) +
-                (h < minimumSubstep ? " failed at minimum step size " + Teuchos::toString(minimumSubstep)
+                (h < minimumSubstep ? format(" failed at minimum step size %.4g", minimumSubstep)
                                     : format(" failed after %d cuts, %.3g of its %.3g done", rec.cutbacks,
                                              tDone_ - tStep, rec.time - tStep)) +
                 ": " + why + brakeDiagnosis(m_.scene) + stickChatterHint(m_.scene, why);

@@ -18,6 +18,7 @@
 #include "collective.hpp"
 #include "errors.hpp"
 #include "linear_solver_factories.hpp"
+#include "log.hpp"
 #include "mumps_solve_factory.hpp"
 
 namespace capstan {
@@ -27,6 +28,12 @@ namespace {
 // |R| of a state with an inverted element (det F <= 0 at a Gauss point): 1e150
 // per dof (Assembly::evaluate); no physical residual comes near.
 constexpr double kInvertedResidual = 1e100;
+
+// How far a failed solve got, for its failure: " at |R| a, from b (tolerance c)".
+std::string residualsReached(const std::vector<double>& norms, double tolerance) {
+  if (norms.empty() || !(norms.back() < kInvertedResidual)) return "";
+  return format(" at |R| %.3g, from %.3g (tolerance %.3g)", norms.back(), norms.front(), tolerance);
+}
 
 using ConverterT = Thyra::TpetraOperatorVectorExtraction<double>;
 
@@ -536,8 +543,9 @@ NewtonResult NewtonSolver::pseudoTransient(Vector& u, double tolerance) {
   r.residualNorm = norm;
   r.converged = valid && std::isfinite(norm) && norm <= tolerance;
   if (!r.converged && r.failure.empty())
-    r.failure = r.iterations >= kPseudoTimeIterations ? "pseudo-transient continuation: iteration limit reached"
-                                                       : "pseudo-transient continuation failed";
+    r.failure = std::string(r.iterations >= kPseudoTimeIterations ? "pseudo-transient continuation: iteration limit reached"
+                                                                  : "pseudo-transient continuation failed") +
+                residualsReached(r.residualHistory, tolerance);
   assembly.evaluate(u, nullptr, nullptr);  // the effects' state at u
   return r;
 }
@@ -608,6 +616,7 @@ NewtonResult NewtonSolver::solve(Vector& u, double tolerance) {
     else if (maxIters->getStatus() == NOX::StatusTest::Failed) r.failure = "Newton iteration limit reached";
     else if (stagnation->getStatus() == NOX::StatusTest::Failed) r.failure = "Newton stagnated";
     else r.failure = "Newton did not converge (line search failed)";
+    if (finite->getStatus() != NOX::StatusTest::Failed) r.failure += residualsReached(history->norms, tolerance);
   }
   impl_->linearSeconds += timer.seconds() - (impl_->assembly.assemblySeconds() - assemblyBefore);
   return r;

@@ -196,7 +196,7 @@ SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterRe
   // Model) (docs/performance.md, "Defaults and why").
   s.minimumSolvePenalty = sol.get<double>("Minimum Solve Penalty");
   if (!(s.minimumSolvePenalty > 0 || s.minimumSolvePenalty == -1) || !std::isfinite(s.minimumSolvePenalty))
-    r.fail("Solver/Minimum Solve Penalty", "must be > 0, or -1 (automatic), got " + Teuchos::toString(s.minimumSolvePenalty));
+    r.fail("Solver/Minimum Solve Penalty", "must be > 0, or -1 (automatic), got " + shortest(s.minimumSolvePenalty));
   s.minimumSolvePenaltyAutomatic = s.minimumSolvePenalty == -1;
   if (s.minimumSolvePenaltyAutomatic)
     s.minimumSolvePenalty = s.pressureUpdate == PressureUpdate::SaddlePoint && !friction ? 3e-2 : 1e-2;
