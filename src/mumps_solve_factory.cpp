@@ -6,7 +6,10 @@
 #include <Thyra_LinearOpWithSolveBase.hpp>
 #include <Thyra_TpetraThyraWrappers.hpp>
 
+#include <cmath>
+#include <cstdio>
 #include <stdexcept>
+#include <vector>
 
 namespace capstan {
 
@@ -17,6 +20,11 @@ namespace {
 
 using ConverterT = Thyra::TpetraOperatorVectorExtraction<double>;
 using Shared = MumpsShared;
+
+// A single factorisation is checked by its probe (MumpsInverseOp::checkSingle):
+// above this error a double one is tried, and kept where it errs this much less.
+constexpr double kSingleProbeLimit = 1e-2;
+constexpr double kDoubleGain = 0.1;
 
 // An operator with its factorisation in the shared solver.
 class MumpsLinearOpWithSolve : public Thyra::LinearOpWithSolveBase<double> {
@@ -114,7 +122,54 @@ class MumpsInverseOp : public Thyra::LinearOpBase<double> {
     if (!shared_->solver) shared_->solver = std::make_unique<MumpsSolver>(shared_->options);
     shared_->factoredFor = nullptr;
     shared_->solver->factor(*matrix_);
+    if (shared_->options.precision == MumpsOptions::Precision::Single && !shared_->singleConfirmed) checkSingle();
     shared_->factoredFor = this;
+  }
+
+  // |M^-1 A v - v| / |v| for a fixed v spread over every dof (A's symmetric
+  // part where that is factored): single factors err there by about 6e-8 x
+  // A's condition, double ones by 1e-16 x it.
+  double probeError() const {
+    MumpsSolver::MultiVector v(matrix_->getDomainMap(), 1), Av(matrix_->getRangeMap(), 1), z(matrix_->getDomainMap(), 1);
+    {
+      auto h = v.getLocalViewHost(Tpetra::Access::OverwriteAll);
+      const auto& map = *matrix_->getDomainMap();
+      for (size_t i = 0; i < h.extent(0); ++i) h(i, 0) = std::sin(0.7548776662 * double(map.getGlobalElement(i)) + 0.3);
+    }
+    matrix_->apply(v, Av);
+    if (shared_->options.symmetricPart) matrix_->apply(v, Av, Teuchos::TRANS, 0.5, 0.5);  // what is factored
+    shared_->solver->solve(Av, z);
+    z.update(-1.0, v, 1.0);
+    std::vector<double> e(1), n(1);
+    z.norm2(e), v.norm2(n);
+    return e[0] / n[0];
+  }
+
+  // Single factors of a nearly singular matrix (a body held by soft springs)
+  // are wrong in its soft modes, and GMRES on them gave Newton directions no
+  // line search could use. Where the probe says so and a double factorisation
+  // is much closer, double from here on (docs/numerics.md, "Single-precision factors").
+  void checkSingle() {
+    const double single = probeError();
+    if (!(single > kSingleProbeLimit)) return;
+    auto singleSolver = std::move(shared_->solver);
+    MumpsOptions options = shared_->options;
+    options.precision = MumpsOptions::Precision::Double;
+    shared_->solver = std::make_unique<MumpsSolver>(options);
+    shared_->solver->factor(*matrix_);
+    const double dbl = probeError();
+    if (dbl < kDoubleGain * single) {
+      shared_->options = options;
+      ++shared_->doubleAfterProbe;
+      if (matrix_->getComm()->getRank() == 0)
+        std::fprintf(stderr,
+                     "capstan: note: the LU preconditioner's single-precision factors err by %.2g on this tangent "
+                     "(double: %.2g), which is nearly singular (a body held by soft supports?): double precision "
+                     "from here on\n", single, dbl);
+    } else {  // the error is the matrix', not the precision's: no more double tries
+      shared_->solver = std::move(singleSolver);
+      shared_->singleConfirmed = true;
+    }
   }
   std::shared_ptr<Shared> shared_;
   RCP<const Thyra::LinearOpBase<double>> op_;
@@ -181,6 +236,7 @@ void readMumpsOptions(Teuchos::ParameterList& list, MumpsShared& shared) {
   shared.options.hostOnlyBelow = hostOnlyBelow;
   shared.solver.reset();
   shared.factoredFor = nullptr;
+  shared.singleConfirmed = false;
 }
 
 void MumpsSolveFactory::setParameterList(const RCP<Teuchos::ParameterList>& list) {
