@@ -160,7 +160,6 @@ class MumpsInverseOp : public Thyra::LinearOpBase<double> {
     const double dbl = probeError();
     if (dbl < kDoubleGain * single) {
       shared_->options = options;
-      ++shared_->doubleAfterProbe;
       if (matrix_->getComm()->getRank() == 0)
         std::fprintf(stderr,
                      "capstan: note: the LU preconditioner's single-precision factors err by %.2g on this tangent "

@@ -22,7 +22,6 @@ struct MumpsShared {
   MumpsOptions options;
   std::unique_ptr<MumpsSolver> solver;  // created on first use
   const void* factoredFor = nullptr;    // the operator whose values are factored
-  int doubleAfterProbe = 0;             // single factors found too far off: double from then on
   bool singleConfirmed = false;         // a double factorisation erred as much: single kept, unprobed
 };
 
