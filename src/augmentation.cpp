@@ -105,6 +105,8 @@ bool AugmentationLoop::solveOnce(double t, double bare, StepRecord& rec, std::st
   frozen_ = false;
   std::optional<StepStart> beforeStep;
   Vector f(m_.u->getMap());
+  double lastWorst = 0;       // the last pass's worst constraint, for the failure
+  std::string lastWorstName;
   for (int it = 1; it <= maxOuter; ++it) {
     const Pass pass = startPass(it, tol, passes, f);
     const NewtonResult r = solvePositions(t, pass, beforeStep.has_value(), rec);
@@ -134,6 +136,7 @@ bool AugmentationLoop::solveOnce(double t, double bare, StepRecord& rec, std::st
     if (holdCyclingSlips(it)) m_.assembly->evaluate(*m_.u, &f, nullptr);  // the held points' tractions
     Constraints c;
     if (!checkConstraints(it, rec, c, failure)) return false;
+    lastWorst = c.worst, lastWorstName = c.worstName;
     // Constraints met: the momentum residual left is Newton's to remove, down
     // to round-off as the nested loop's last pass does (one polishing step
     // within the tolerance), so the two loops' answers agree to round-off.
@@ -158,8 +161,8 @@ bool AugmentationLoop::solveOnce(double t, double bare, StepRecord& rec, std::st
     }
     if (passLimit > 0 && it >= passLimit) return true;  // a starting guess: the moved state
   }
-  failure = "augmentation loop did not meet the volume and contact tolerances in " + std::to_string(maxOuter) +
-            " iterations";
+  failure = format("augmentation loop did not meet the volume and contact tolerances in %d passes: %s at %.3g x its "
+                   "tolerance at the last", maxOuter, lastWorstName.c_str(), lastWorst);
   return false;
 }
 
