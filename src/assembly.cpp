@@ -61,12 +61,14 @@ void Assembly::buildGraph() {
   struct Stiff {
     HostDofs dofs;
     size_t rows;
+    std::vector<size_t> coreFirst;  // entity e moves the cores' free unknowns coreDofs[coreFirst[e] .. [e + 1])
+    std::vector<int> coreDofs;
   };
   std::vector<Stiff> stiff;
   for (const auto& effect : effects_.all) {
     if (!effect->local().stiff) continue;  // no stiffness, no graph entries
     auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), effect->local().dofs);
-    stiff.push_back({dofs, effect->local().rowDofs > 0 ? size_t(effect->local().rowDofs) : dofs.extent(1)});
+    stiff.push_back({dofs, effect->local().rowDofs > 0 ? size_t(effect->local().rowDofs) : dofs.extent(1), {}, {}});
   }
   // The entities at each row dof (CSR: touching[first[d] .. first[d + 1]) as (effect, entity)).
   const size_t nDofs = size_t(layout_.size());
@@ -82,9 +84,19 @@ void Assembly::buildGraph() {
       for (size_t e = 0; e < stiff[i].dofs.extent(0); ++e)
         for (size_t k = 0; k < stiff[i].rows; ++k) touching[next[stiff[i].dofs(e, k)]++] = {int(i), int(e)};
   }
+  // The cores' free unknowns each entity moves with (entities at a core's face only).
   const auto asDof = [](int dof) { return GO(dof); };
+  std::vector<GO> cols;
+  for (auto& st : stiff) {
+    st.coreFirst.assign(st.dofs.extent(0) + 1, 0);
+    for (size_t e = 0; e < st.dofs.extent(0) && !cores_.empty(); ++e) {
+      cols.clear();
+      cores_.appendFreeUnknowns(&st.dofs(e, 0), st.dofs.extent(1), asDof, cols);
+      st.coreDofs.insert(st.coreDofs.end(), cols.begin(), cols.end());
+      st.coreFirst[e + 1] = st.coreDofs.size();
+    }
+  }
   std::vector<int> seenBy(nDofs, -1);  // the row whose columns already hold this dof
-  std::vector<GO> cols, coreDofs;
   for (size_t d = 0; d < nDofs; ++d) {
     if (first[d] == first[d + 1]) continue;
     cols.clear();
@@ -93,28 +105,25 @@ void Assembly::buildGraph() {
     };
     for (size_t t = first[d]; t < first[d + 1]; ++t) {
       const auto& [i, e] = touching[t];
-      const auto& dofs = stiff[i].dofs;
-      for (size_t k = 0; k < dofs.extent(1); ++k) add(dofs(e, k));
-      coreDofs.clear();
-      cores_.appendFreeUnknowns(&dofs(e, 0), dofs.extent(1), asDof, coreDofs);
-      for (GO c : coreDofs) add(int(c));
+      const Stiff& st = stiff[i];
+      for (size_t k = 0; k < st.dofs.extent(1); ++k) add(st.dofs(e, k));
+      for (size_t c = st.coreFirst[e]; c < st.coreFirst[e + 1]; ++c) add(st.coreDofs[c]);
     }
     graph_->insertGlobalIndices(gid(int(d)), Teuchos::ArrayView<const GO>(cols));
   }
   // A core's unknowns' rows (the chain rule's): every column of the entities at its face.
   std::map<GO, std::vector<GO>> coreRows;
-  if (!cores_.empty())
-    for (const auto& st : stiff)
-      for (size_t e = 0; e < st.dofs.extent(0); ++e) {
-        cols.clear();
-        for (size_t k = 0; k < st.dofs.extent(1); ++k) cols.push_back(gid(st.dofs(e, k)));
-        const size_t nodeCols = cols.size();
-        cores_.appendFreeUnknowns(&st.dofs(e, 0), st.dofs.extent(1), gid, cols);
-        for (size_t k = nodeCols; k < cols.size(); ++k) {
-          auto& row = coreRows[cols[k]];
-          row.insert(row.end(), cols.begin(), cols.end());
-        }
+  for (const auto& st : stiff)
+    for (size_t e = 0; e < st.dofs.extent(0); ++e) {
+      if (st.coreFirst[e] == st.coreFirst[e + 1]) continue;
+      cols.clear();
+      for (size_t k = 0; k < st.dofs.extent(1); ++k) cols.push_back(gid(st.dofs(e, k)));
+      for (size_t c = st.coreFirst[e]; c < st.coreFirst[e + 1]; ++c) cols.push_back(gid(st.coreDofs[c]));
+      for (size_t c = st.coreFirst[e]; c < st.coreFirst[e + 1]; ++c) {
+        auto& row = coreRows[gid(st.coreDofs[c])];
+        row.insert(row.end(), cols.begin(), cols.end());
       }
+    }
   for (auto& [row, rowCols] : coreRows) {
     std::sort(rowCols.begin(), rowCols.end());
     rowCols.erase(std::unique(rowCols.begin(), rowCols.end()), rowCols.end());
