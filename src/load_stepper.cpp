@@ -60,6 +60,9 @@ bool LoadStepper::advance(StepRecord& rec, std::string& failure) {
   // The step's start: a failed step's converged sub-steps are not outputs.
   const auto atStep = m_.snapshot();
   const double tStep = tDone_;
+  const bool andersonMayFail = !m_.pressureStep && m_.scene.solver.saddlePointIfAndersonFails;
+  const auto predictorsAtStep = andersonMayFail ? predictors_.memory() : Predictors::Memory{};
+  int cutsBefore = 0;  // the cuts of a failed Anderson try (below)
   while (tDone_ < rec.time - 1e-12 * dt) {
     const double tEnd = std::min(tDone_ + h, rec.time);
     // The cores' records from u: a failed attempt left them at its last trial,
@@ -98,7 +101,22 @@ bool LoadStepper::advance(StepRecord& rec, std::string& failure) {
       chatterHinted_ = true;  // once a run: the hint, before the cuts' retries
       log_.progress("  " + hint.substr(2));
     }
-    if (h < minimumSubstep || rec.cutbacks > kMostCutsPerStep) {
+    const bool lastTry = h < minimumSubstep || rec.cutbacks - cutsBefore > kMostCutsPerStep;
+    if (lastTry && andersonMayFail && !m_.pressureStep) {
+      // Auto's Anderson loop failed the step through every cut, where the saddle-point step can
+      // converge (a soft stick: docs/numerics.md): the step again with it, kept from here on.
+      m_.buildPressureStep();
+      log_.progress(format("  step %d: the Anderson loop failed through %d cuts (%s); the step again with the "
+                           "saddle-point pressure step, kept from here on",
+                           rec.step, rec.cutbacks, why.c_str()));
+      m_.restore(atStep);
+      predictors_.recall(predictorsAtStep);
+      tDone_ = tStep;
+      h = rec.time - tDone_;
+      cutsBefore = rec.cutbacks;
+      continue;
+    }
+    if (lastTry) {
       failure = "step " + std::to_string(rec.step) +
                 (h < minimumSubstep ? format(" failed at minimum step size %.4g", minimumSubstep)
                                     : format(" failed after %d cuts, %.3g of its %.3g done", rec.cutbacks,

@@ -42,26 +42,7 @@ Model::Model(const Scene& scene_, const RCP<const Comm>& comm_)
   } catch (const InputError& e) {  // the Solver/NOX or Solver/Stratimikos sublist
     throw InputError(scene.file + ": " + e.what());
   }
-  using S = SolverSettings;
-  if (scene.solver.pressureUpdate == S::PressureUpdate::SaddlePoint) {
-    const auto schur = scene.solver.pressureStepSchur;
-    const bool laplacian = schur == S::Schur::Laplacian || (schur == S::Schur::Auto && newton->iterative());
-    // Auto: the factored block matrix for steady rolling above
-    // kStepLUAboveDofs unknowns where Newton's solves factor the matrix (a
-    // direct solver, or GMRES with the LU preconditioner; next to multigrid it
-    // would be the largest factorisation of the run).
-    const auto choice = scene.solver.pressureStepPreconditioner;
-    const long dofs = long(assembly->dofMap()->getGlobalNumElements());
-    const bool lu = choice == S::StepPreconditioner::LU ||
-                    (choice == S::StepPreconditioner::Auto && scene.analysis.steady() && !newton->iterative() &&
-                     dofs > S::kStepLUAboveDofs);
-    const auto preconditioner = lu ? PressureStep::Preconditioner::LU : PressureStep::Preconditioner::Block;
-    pressureStep = std::make_unique<PressureStep>(
-        *assembly, laplacian ? PressureStep::Schur::Laplacian : PressureStep::Schur::Diagonal, preconditioner);
-    monolithic = scene.solver.monolithic && !(scene.solver.monolithicIfExact && newton->iterative());
-    if (monolithic && scene.solver.minimumSolvePenaltyAutomatic)
-      assembly->bricks().setSolvePenalty(std::max(scene.pressurePenalty, S::kMonolithicSolvePenalty / scene.c));
-  }
+  if (scene.solver.pressureUpdate == SolverSettings::PressureUpdate::SaddlePoint) buildPressureStep();
   u = rcp(new Vector(assembly->dofMap()));
   for (const auto& core : assembly->rigidCores()) rolling = rolling || core.free[3];
   double size2 = 0;
@@ -71,6 +52,27 @@ Model::Model(const Scene& scene_, const RCP<const Comm>& comm_)
   if (absTolerance == 0) absTolerance = 1e-13 * forceScale;
   long localFaces = long(assembly->contactFaceNodes().size() / 4);
   Teuchos::reduceAll(*comm, Teuchos::REDUCE_SUM, localFaces, Teuchos::outArg(numContactFaces));
+}
+
+void Model::buildPressureStep() {
+  using S = SolverSettings;
+  const auto schur = scene.solver.pressureStepSchur;
+  const bool laplacian = schur == S::Schur::Laplacian || (schur == S::Schur::Auto && newton->iterative());
+  // Auto: the factored block matrix for steady rolling above
+  // kStepLUAboveDofs unknowns where Newton's solves factor the matrix (a
+  // direct solver, or GMRES with the LU preconditioner; next to multigrid it
+  // would be the largest factorisation of the run).
+  const auto choice = scene.solver.pressureStepPreconditioner;
+  const long dofs = long(assembly->dofMap()->getGlobalNumElements());
+  const bool lu = choice == S::StepPreconditioner::LU ||
+                  (choice == S::StepPreconditioner::Auto && scene.analysis.steady() && !newton->iterative() &&
+                   dofs > S::kStepLUAboveDofs);
+  const auto preconditioner = lu ? PressureStep::Preconditioner::LU : PressureStep::Preconditioner::Block;
+  pressureStep = std::make_unique<PressureStep>(
+      *assembly, laplacian ? PressureStep::Schur::Laplacian : PressureStep::Schur::Diagonal, preconditioner);
+  monolithic = scene.solver.monolithic && !(scene.solver.monolithicIfExact && newton->iterative());
+  if (monolithic && scene.solver.minimumSolvePenaltyAutomatic)
+    assembly->bricks().setSolvePenalty(std::max(scene.pressurePenalty, S::kMonolithicSolvePenalty / scene.c));
 }
 
 double Model::linearSolveSeconds() const {

@@ -51,6 +51,9 @@ struct Model {
     u->update(1.0, s.u, 0.0);
     restoreState(effects(), s.effects);
   }
+  // The saddle-point pressure step (Solver/Pressure Update), also built mid-run where Auto's
+  // Anderson loop fails (AugmentationLoop::solve).
+  void buildPressureStep();
   // Newton's linear solves and the pressure steps' block solves.
   double linearSolveSeconds() const;
 };

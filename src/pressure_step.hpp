@@ -49,6 +49,7 @@
 // unknowns (as the matrix assembly does); held dofs are left out.
 #pragma once
 
+#include <array>
 #include <functional>
 #include <memory>
 #include <string>
@@ -101,6 +102,10 @@ class PressureStep {
   bool factorsBlockMatrix() const { return preconditioner_ == Preconditioner::LU; }
   void useBlockPreconditioner() { preconditioner_ = Preconditioner::Block; }
   double seconds() const { return seconds_; }
+  // What a step carries to the next (the stop rule's miss ratio and last prediction), for a
+  // checkpoint: a restarted run repeats the uninterrupted one's arithmetic.
+  std::array<double, 2> carried() const { return {missRatio_, lastPredicted_}; }
+  void recall(const std::array<double, 2>& c) { missRatio_ = c[0], lastPredicted_ = c[1]; }
 
  private:
   struct Block {

@@ -64,6 +64,9 @@ std::string checkpointBytes(const Model& model, const Timings& timings, const st
   }
   // The predictors' base state, in u's layout (the node ids above).
   w.put(predictors.u), w.put(predictors.rotations), w.put<double>(predictors.t);
+  // The saddle-point step taken up where Auto's Anderson loop failed (LoadStepper::advance).
+  w.put<int>(model.pressureStep ? 1 : 0);
+  if (model.pressureStep) w.put(model.pressureStep->carried());
   // Rank 0: the step records, and what the summary adds up over the runs.
   if (model.rank0) {
     w.put<int>(int(steps.size()));
@@ -208,6 +211,8 @@ Restart::Restart(const Scene& scene, const Comm& comm, const std::string& dir)
 void Restart::restore(Model& model, std::vector<StepRecord>& steps, Timings& earlier) {
   const auto& mesh = model.mesh;
   std::string error;
+  bool pressureStep = false;
+  std::array<double, 2> carried{};
   try {
     auto& in = *in_;
     // Displacement: every owned node's value, found by node id.
@@ -296,6 +301,8 @@ void Restart::restore(Model& model, std::vector<StepRecord>& steps, Timings& ear
     for (size_t i = 0; i < gids.size() && !previous.empty(); ++i)
       for (int c = 0; c < 3; ++c) predictors_.u[3 * owned.at(gids[i]) + c] = previous[3 * i + c];
     for (size_t j = 3 * gids.size(); j < previous.size(); ++j) predictors_.u[j] = previous[j];
+    pressureStep = in.get<int>() == 1;
+    if (pressureStep) carried = in.get<std::array<double, 2>>();
     if (model.rank0) {
       const int n = in.get<int>();
       for (int i = 0; i < n; ++i) steps.push_back(checkpoint::get(in));
@@ -314,6 +321,8 @@ void Restart::restore(Model& model, std::vector<StepRecord>& steps, Timings& ear
     error = where() + file_.string() + ": " + e.what();
   }
   agreeInput(comm_, error);
+  if (pressureStep && !model.pressureStep) model.buildPressureStep();
+  if (pressureStep) model.pressureStep->recall(carried);
   // fields.h5 is continued: the earlier run's must be there to append to.
   int found = 1;
   if (model.rank0 && scene_.writeFields) found = fs::exists(fs::path(dir_) / "fields.h5") ? 1 : 0;

@@ -95,7 +95,8 @@ void SolverSettings::declare(ParameterList& sol) {
           "Anderson (pbar <- p(x), Anderson-accelerated), or Auto (Monolithic without friction where the step's K^-1 is exact, with a direct solver or the LU "
           "preconditioner, Saddle Point elsewhere without friction, for a "
           "free-turning core rolling with friction in the quasi-static analysis and for steady rolling; "
-          "Anderson for other friction scenes; docs/friction.md, \"The multiplier loop in rolling\", "
+          "Anderson for other friction scenes, Saddle Point from a step Anderson fails through every cut; "
+          "docs/friction.md, \"The multiplier loop in rolling\", "
           "docs/performance.md, \"Defaults and why\")");
   sol.set("Pressure Step Schur", std::string("Auto"),
           "The saddle-point step's approximation of its volume rows' Schur complement: Laplacian "
@@ -179,6 +180,7 @@ SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterRe
   s.pressureUpdate = update == Update::SaddlePoint || s.monolithic || (update == Update::Auto && (rolling || steady))
                          ? PressureUpdate::SaddlePoint
                          : PressureUpdate::Anderson;
+  s.saddlePointIfAndersonFails = update == Update::Auto && s.pressureUpdate == PressureUpdate::Anderson;
   s.pressureStepSchur = r.choice(sol, at, "Pressure Step Schur",
                                  std::vector<std::pair<const char*, Schur>>{
                                      {"Auto", Schur::Auto}, {"Laplacian", Schur::Laplacian}, {"Diagonal", Schur::Diagonal}});

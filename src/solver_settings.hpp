@@ -42,6 +42,9 @@ struct SolverSettings {
   double volumeTolerance = 0;
   int maxPressureIterations = 0;
   PressureUpdate pressureUpdate{};
+  // Auto's Anderson (friction without rolling): a step whose loop fails is solved again with the
+  // saddle-point step, kept from there on (AugmentationLoop::solve).
+  bool saddlePointIfAndersonFails = false;
   // Pressure Update = Monolithic (Auto without friction): each pass one saddle-point step from the
   // last, no Newton solve between (src/augmentation.cpp). Auto's only where the step's K^-1 is
   // exact (a direct solver or the LU preconditioner; Model decides).

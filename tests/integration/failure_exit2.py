@@ -32,8 +32,9 @@ p^H*A*p").
 
 Case E, G1 pressed 0.1 a step for 11 steps: step 9 (0.9 of the 1.75 high block)
 converges, step 10 cannot. The failure says where the last converged mesh is most
-distorted: det F 0.48 at a Gauss point of the element around (4.25, 1.53, 1) or its
-mirror image at z = 3 (formulation.md's G1 is symmetric about z = 2). Cases A-D are
+distorted: det F 0.48 at a Gauss point of the element around (4.25, 1.53, 1) or one of
+its mirror images at x = 2.75 and z = 3 (formulation.md's G1 is symmetric about x = 3.5
+and z = 2; which one round-off names differs between machines). Cases A-D are
 not distorted (det F above 0.5 everywhere), and their failures say nothing of it.
 
 Checks, every case: exit status 2; summary.json has "converged": false, a
@@ -174,7 +175,8 @@ sE, outE, fE = common("E-deep", ["Time/Steps=11"], min_steps=9, scene_file=T.inp
 m = re.search(r"det F = ([0-9.e+-]+), in the element around \(([^)]*)\)", sE["failure"])
 at = [float(x) for x in m.group(2).split(",")] if m else []
 T.check(m is not None and abs(float(m.group(1)) - 0.48) < 0.01 and len(at) == 3
-        and abs(at[0] - 4.25) < 1e-9 and abs(at[1] - 1.53125) < 1e-3 and min(abs(at[2] - 1), abs(at[2] - 3)) < 1e-9,
+        and min(abs(at[0] - 4.25), abs(at[0] - 2.75)) < 1e-9 and abs(at[1] - 1.53125) < 1e-3
+        and min(abs(at[2] - 1), abs(at[2] - 3)) < 1e-9,
         f"E: the failure names the most distorted element: {sE['failure']!r}")
 for label, sx in (("A", sA), ("B", sB), ("C", sC), ("D", sD)):
     T.check("det F" not in sx["failure"], f"{label}: no distortion note: {sx['failure']!r}")
