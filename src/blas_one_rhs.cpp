@@ -12,14 +12,18 @@
 // them (CMakeLists.txt), so the dynamic linker binds MUMPS' (and Trilinos')
 // calls here before the BLAS library; every other call goes on to the BLAS
 // library's own routine (dlsym RTLD_NEXT). Same arithmetic, another order of
-// the sums: results change in the last bits only. CAPSTAN_BLAS_ONE_RHS=off in
-// the environment sends every call to the library (for comparisons).
+// the sums: results change in the last bits only. Not where the library has a
+// small-matrix path that does not pack (below). CAPSTAN_BLAS_ONE_RHS=off or on
+// in the environment overrides the choice (for comparisons).
 #include <dlfcn.h>
 
 #include <cstddef>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <initializer_list>
+
+#include <strings.h>
 
 extern "C" {
 void sgemv_(const char*, const int*, const int*, const float*, const float*, const int*, const float*, const int*,
@@ -56,10 +60,26 @@ F blasRoutine(const char* name) {
 
 bool transposed(const char* op) { return *op != 'N' && *op != 'n'; }
 
+// Whether the BLAS library multiplies small matrices without packing them: OpenBLAS' AVX-512
+// kernels (SkylakeX, Cooperlake, SapphireRapids) have such a path, and there the library's own
+// routines were as fast or faster on G1 2x (docs/performance.md, "Defaults and why").
+bool libraryHasSmallGemm() {
+  using CoreName = const char* (*)();
+  const auto corename = reinterpret_cast<CoreName>(dlsym(RTLD_DEFAULT, "openblas_get_corename"));
+  const char* core = corename ? corename() : nullptr;
+  if (!core) return false;
+  for (const char* name : {"skylakex", "cooperlake", "sapphirerapids"})
+    if (strcasecmp(core, name) == 0) return true;
+  return false;
+}
+
+// CAPSTAN_BLAS_ONE_RHS = on or off forces the choice; unset: on unless the library has that path.
 bool enabled() {
   static const bool on = [] {
     const char* v = std::getenv("CAPSTAN_BLAS_ONE_RHS");
-    return !(v && (std::strcmp(v, "off") == 0 || std::strcmp(v, "0") == 0));
+    if (v && (std::strcmp(v, "off") == 0 || std::strcmp(v, "0") == 0)) return false;
+    if (v && (std::strcmp(v, "on") == 0 || std::strcmp(v, "1") == 0)) return true;
+    return !libraryHasSmallGemm();
   }();
   return on;
 }
