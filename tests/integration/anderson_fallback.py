@@ -10,7 +10,7 @@ the saddle-point pressure step, which the run keeps (src/load_stepper.cpp).
 Checks:
 - Auto: exit 0, the switch reported once on the progress lines, and every step's capstan
   force equal to the run with `Pressure Update = Saddle Point` from the start (1e-8 of
-  the largest force).
+  the largest force); the same on 2 ranks, its forces those of 1 rank (1e-8).
 - `Pressure Update = Anderson` named: exit 2 at step 1 (nothing switches a named update),
   so the fallback is what rescues the run.
 - A checkpoint after the switch (3 steps, Checkpoint Every = 2) restarts with the
@@ -44,6 +44,13 @@ if T.check(s is not None and s["converged"] and s2 is not None and s2["converged
     scale = max(abs(v) for f in forces(s2) for v in f)
     worst = max(abs(a - b) for fa, fb in zip(forces(s), forces(s2)) for a, b in zip(fa, fb)) / scale
     T.check(worst <= 1e-8, f"Auto's forces against Saddle Point's from the start: {worst:.1e} of the largest (1e-8)")
+
+p4, s4, _ = T.run_scene(SCENE, "auto-2ranks", sets=SOFT, ranks=2, quiet=False)
+if s is not None and s["converged"] and T.check(s4 is not None and s4["converged"], "Auto on 2 ranks converges"):
+    T.check(p4.stdout.count(SWITCH) == 1, "2 ranks: the switch reported once")
+    scale = max(abs(v) for f in forces(s) for v in f)
+    worst = max(abs(a - b) for fa, fb in zip(forces(s), forces(s4)) for a, b in zip(fa, fb)) / scale
+    T.check(worst <= 1e-8, f"1 and 2 ranks' forces: {worst:.1e} of the largest (1e-8)")
 
 p3, s3, _ = T.run_scene(SCENE, "anderson", sets=SOFT + ["Solver/Pressure Update=Anderson"], expect_rc=2)
 if s3 is not None:
