@@ -1,6 +1,7 @@
 #include "augmentation.hpp"
 
 #include "errors.hpp"
+#include "solver_switches.hpp"
 #include "stopwatch.hpp"
 
 #include <Teuchos_CommHelpers.hpp>
@@ -81,6 +82,7 @@ bool AugmentationLoop::solve(double t, double bare, StepRecord& rec, std::string
   // block-triangular step, which converged there (docs/numerics.md).
   if (m_.pressureStep && m_.pressureStep->factorsBlockMatrix()) {
     m_.pressureStep->useBlockPreconditioner();
+    solver_switches::note("the block-triangular pressure step (the loop failed with the factored block matrix)");
     if (log_.on("newton"))
       log_.event("newton", "the loop failed with the factored block matrix: the block-triangular step from here on",
                  eventOf("pressure_step_block_from_here"));
@@ -426,6 +428,9 @@ bool AugmentationLoop::saddlePointPressureStep(double t, Vector& f, bool volumeM
                  .add("predictions", json::number(step.predictions))
                  .add("contact_rows", json::number(step.contactRows))
                  .add("seconds", json::number(since(stepStart))));
+  if (!step.luRefused.empty())
+    solver_switches::note("the block-triangular pressure step (MUMPS did not factor the block matrix: " +
+                          step.luRefused + ")");
   if (!step.luRefused.empty() && log_.on("newton"))
     log_.event("newton", "pressure step: its block matrix not factored (" + step.luRefused + "): Block from here on",
                eventOf("pressure_step_lu_refused"));

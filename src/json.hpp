@@ -35,6 +35,13 @@ inline std::string array(const std::vector<double>& v) {
   return out + "]";
 }
 
+// [v, ...] from already-serialised values.
+inline std::string list(const std::vector<std::string>& rawValues) {
+  std::string out = "[";
+  for (size_t i = 0; i < rawValues.size(); ++i) out += (i ? ", " : "") + rawValues[i];
+  return out + "]";
+}
+
 // Builds {"k": v, ...} from already-serialised values.
 class Object {
  public:

@@ -4,6 +4,7 @@
 
 #include "effect_state.hpp"
 #include "rolling.hpp"
+#include "solver_switches.hpp"
 
 namespace capstan {
 
@@ -106,6 +107,8 @@ bool LoadStepper::advance(StepRecord& rec, std::string& failure) {
       // Auto's Anderson loop failed the step through every cut, where the saddle-point step can
       // converge (a soft stick: docs/numerics.md): the step again with it, kept from here on.
       m_.buildPressureStep();
+      solver_switches::note(format("the saddle-point pressure step (the Anderson loop failed the step through %d cuts)",
+                                   rec.cutbacks));
       log_.progress(format("  step %d: the Anderson loop failed through %d cuts (%s); the step again with the "
                            "saddle-point pressure step, kept from here on",
                            rec.step, rec.cutbacks, why.c_str()));

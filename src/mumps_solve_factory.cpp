@@ -11,6 +11,9 @@
 #include <stdexcept>
 #include <vector>
 
+#include "log.hpp"
+#include "solver_switches.hpp"
+
 namespace capstan {
 
 using Teuchos::RCP;
@@ -160,6 +163,8 @@ class MumpsInverseOp : public Thyra::LinearOpBase<double> {
     const double dbl = probeError();
     if (dbl < kDoubleGain * single) {
       shared_->options = options;
+      solver_switches::note(format("the LU preconditioner's factors in double precision (single erred by %.2g, "
+                                   "double by %.2g)", single, dbl));
       if (matrix_->getComm()->getRank() == 0)
         std::fprintf(stderr,
                      "capstan: note: the LU preconditioner's single-precision factors err by %.2g on this tangent "

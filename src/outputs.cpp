@@ -282,7 +282,8 @@ Timings Outputs::timings() const {
   return t;
 }
 
-void Outputs::writeSummary(const std::vector<StepRecord>& steps, bool converged, const std::string& failure) {
+void Outputs::writeSummary(const std::vector<StepRecord>& steps, const std::vector<SolverSwitch>& switches,
+                           bool converged, const std::string& failure) {
   const StateFigures s = stateFigures(m_);
   const auto [peakMiB, hugeMiB, faults] = memoryFigures(*m_.comm);
   if (!m_.rank0) return;
@@ -293,6 +294,9 @@ void Outputs::writeSummary(const std::vector<StepRecord>& steps, bool converged,
   std::string stepList = "[";
   for (size_t i = 0; i < steps.size(); ++i) stepList += (i ? ",\n    " : "\n    ") + toJson(steps[i]);
   stepList += "\n  ]";
+  std::vector<std::string> switchList;
+  for (const auto& w : switches)
+    switchList.push_back(Object().add("step", json::number(w.step)).add("what", json::string(w.what)).str());
   const char* comp[6] = {"xx", "yy", "zz", "xy", "yz", "xz"};
   Object stress, faces;
   for (int k = 0; k < 6; ++k) stress.add(comp[k], range(s.stress[k]));
@@ -333,6 +337,7 @@ void Outputs::writeSummary(const std::vector<StepRecord>& steps, bool converged,
       .add("analysis", json::string(m_.scene.analysis.name()))  // interface.md, "Steady rolling"
       .add("converged", converged ? "true" : "false")
       .add("failure", converged ? "null" : json::string(failure))
+      .add("solver_switches", json::list(switchList))
       .add("mesh", meshObject.str()).add("steps", stepList).add("final", fin.str())
       .add("timing", timing.str()).add("memory", memory.str()).add("effects", effects.str());
   writeAtomically(dir_ / "summary.json", top.str() + "\n");

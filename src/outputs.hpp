@@ -14,6 +14,7 @@
 #include "nip_table.hpp"
 #include "log.hpp"
 #include "model.hpp"
+#include "solver_switches.hpp"
 #include "step_record.hpp"
 
 namespace capstan {
@@ -54,7 +55,8 @@ class Outputs {
   // then each converged step's rows (collective).
   void openNip(int lastKept);
   void writeNip(int step);
-  void writeSummary(const std::vector<StepRecord>& steps, bool converged, const std::string& failure);
+  void writeSummary(const std::vector<StepRecord>& steps, const std::vector<SolverSwitch>& switches, bool converged,
+                    const std::string& failure);
   // This run's timings plus the earlier runs' (`earlier`, from a checkpoint).
   Timings timings() const;
   Timings earlier;

@@ -38,7 +38,8 @@ std::vector<long long> entityKeys(const Mesh& mesh, const Effect& e, int& perEnt
 }
 
 std::string checkpointBytes(const Model& model, const Timings& timings, const std::vector<StepRecord>& steps,
-                            int step, double time, const Predictors::Memory& predictors) {
+                            const std::vector<SolverSwitch>& switches, int step, double time,
+                            const Predictors::Memory& predictors) {
   const auto& scene = model.scene;
   const auto& mesh = model.mesh;
   checkpoint::Writer w;
@@ -74,14 +75,17 @@ std::string checkpointBytes(const Model& model, const Timings& timings, const st
     w.put(timings.total), w.put(timings.assembly), w.put(timings.linearSolve), w.put(timings.output);
     w.put(timings.preconditionerSetup);
     for (const auto& e : timings.effects) w.put<long>(e.launches), w.put<double>(e.seconds);
+    w.put<int>(int(switches.size()));
+    for (const auto& s : switches) w.put<int>(s.step), w.put(s.what);
   }
   return w.bytes();
 }
 
 }  // namespace
 
-void writeCheckpoint(const Model& model, Outputs& outputs, const std::vector<StepRecord>& steps, int step,
-                     double time, const Predictors::Memory& predictors) {
+void writeCheckpoint(const Model& model, Outputs& outputs, const std::vector<StepRecord>& steps,
+                     const std::vector<SolverSwitch>& switches, int step, double time,
+                     const Predictors::Memory& predictors) {
   const auto t = std::chrono::steady_clock::now();
   const Comm& comm = *model.comm;
   const fs::path root = outputs.directory() / "checkpoint";
@@ -99,7 +103,7 @@ void writeCheckpoint(const Model& model, Outputs& outputs, const std::vector<Ste
   agreeRuntime(comm, error);
   try {
     writeAtomically(tmp / checkpoint::rankFile(comm.getRank()),
-                    checkpointBytes(model, outputs.timings(), steps, step, time, predictors));
+                    checkpointBytes(model, outputs.timings(), steps, switches, step, time, predictors));
   } catch (const std::exception& e) {
     error = std::string("checkpoint: ") + e.what();
   }
@@ -208,7 +212,8 @@ Restart::Restart(const Scene& scene, const Comm& comm, const std::string& dir)
   agreeInput(comm, error.empty() ? "" : where() + error);
 }
 
-void Restart::restore(Model& model, std::vector<StepRecord>& steps, Timings& earlier) {
+void Restart::restore(Model& model, std::vector<StepRecord>& steps, std::vector<SolverSwitch>& switches,
+                      Timings& earlier) {
   const auto& mesh = model.mesh;
   std::string error;
   bool pressureStep = false;
@@ -315,6 +320,8 @@ void Restart::restore(Model& model, std::vector<StepRecord>& steps, Timings& ear
         t.seconds = in.get<double>();
         earlier.effects.push_back(t);
       }
+      switches.resize(size_t(in.get<int>()));
+      for (auto& s : switches) s.step = in.get<int>(), s.what = in.getString();
     }
     if (!in.atEnd()) throw std::runtime_error("damaged (data after the end)");
   } catch (const std::exception& e) {

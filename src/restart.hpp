@@ -19,14 +19,16 @@
 #include "model.hpp"
 #include "outputs.hpp"
 #include "predictors.hpp"
+#include "solver_switches.hpp"
 #include "step_record.hpp"
 
 namespace capstan {
 
 // Writes OUTDIR/checkpoint/step-<k>/ (collective; one file per rank, published
 // by a rename when all are written), then removes the older ones.
-void writeCheckpoint(const Model& model, Outputs& outputs, const std::vector<StepRecord>& steps, int step,
-                     double time, const Predictors::Memory& predictors);
+void writeCheckpoint(const Model& model, Outputs& outputs, const std::vector<StepRecord>& steps,
+                     const std::vector<SolverSwitch>& switches, int step, double time,
+                     const Predictors::Memory& predictors);
 
 // Removes the checkpoints in OUTDIR/checkpoint but `keep` (rank 0): an earlier
 // run's do not belong to this one.
@@ -45,7 +47,7 @@ class Restart {
   // Loads u, the effects' multipliers and history, and (rank 0) the step
   // records and the earlier runs' timings into the built run; checks that
   // fields.h5 is there to continue. Throws InputError where it does not fit.
-  void restore(Model& model, std::vector<StepRecord>& steps, Timings& earlier);
+  void restore(Model& model, std::vector<StepRecord>& steps, std::vector<SolverSwitch>& switches, Timings& earlier);
   // The predictors' memory read by restore().
   const Predictors::Memory& predictors() const { return predictors_; }
   // Continues the earlier run's fields.h5 in `outputDir` (a copy when this run

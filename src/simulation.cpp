@@ -9,6 +9,7 @@
 #include "model.hpp"
 #include "outputs.hpp"
 #include "restart.hpp"
+#include "solver_switches.hpp"
 #include "step_figures.hpp"
 #include "stopwatch.hpp"
 
@@ -41,7 +42,7 @@ class Simulation {
     model_ = std::make_unique<Model>(scene_, comm_);
     warnOfMeshDependentSettings();
     outputs_ = std::make_unique<Outputs>(*model_, log_, start_);
-    if (restart_) restart_->restore(*model_, steps_, outputs_->earlier);
+    if (restart_) restart_->restore(*model_, steps_, switches_, outputs_->earlier);
     openOutputs();
     LoadStepper stepper(*model_, log_, options_.checkTangent, restart_ ? restart_->time() : 0.0);
     if (restart_) stepper.predictors().recall(restart_->predictors());
@@ -54,6 +55,7 @@ class Simulation {
       rec.step = step;
       rec.time = step * scene_.stepSize;
       ok = stepper.advance(rec, failure);
+      for (auto& what : solver_switches::take()) switches_.push_back({step, std::move(what)});
       if (ok) finishStep(rec, stepper, stepStart);
     }
     if (!ok) {
@@ -61,7 +63,7 @@ class Simulation {
       failure += distortionNote(model_->assembly->bricks().mostCompressed(*comm_));
     }
     outputs_->writeHistory(steps_);
-    outputs_->writeSummary(steps_, ok, failure);
+    outputs_->writeSummary(steps_, switches_, ok, failure);
     if (!ok && model_->rank0) std::fprintf(stderr, "capstan: did not converge: %s\n", failure.c_str());
     return ok ? 0 : 2;
   }
@@ -111,11 +113,11 @@ class Simulation {
     outputs_->writeHistory(steps_);
     // A run that ends before its own summary (killed, or MPI_Abort where a
     // failure on one rank alone left the others stuck) leaves this one.
-    outputs_->writeSummary(steps_, false,
+    outputs_->writeSummary(steps_, switches_, false,
                            "the run stopped after step " + std::to_string(rec.step) + " of " +
                                std::to_string(scene_.steps) + " without finishing its summary (killed, or see its stderr)");
     if (scene_.checkpointEvery > 0 && rec.step % scene_.checkpointEvery == 0)
-      writeCheckpoint(*model_, *outputs_, steps_, rec.step, stepper.time(), stepper.predictors().memory());
+      writeCheckpoint(*model_, *outputs_, steps_, switches_, rec.step, stepper.time(), stepper.predictors().memory());
     for (const auto& line : progressLines(rec, scene_.steps, outputs_->timings().total)) log_.progress(line);
   }
 
@@ -128,6 +130,7 @@ class Simulation {
   std::unique_ptr<Model> model_;
   std::unique_ptr<Outputs> outputs_;
   std::vector<StepRecord> steps_;
+  std::vector<SolverSwitch> switches_;  // summary.json's "solver_switches"
 };
 
 }  // namespace

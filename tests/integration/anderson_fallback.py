@@ -8,14 +8,15 @@ above its tolerance after 100 passes). The step is then solved again from its st
 the saddle-point pressure step, which the run keeps (src/load_stepper.cpp).
 
 Checks:
-- Auto: exit 0, the switch reported once on the progress lines, and every step's capstan
+- Auto: exit 0, the switch reported once on the progress lines and listed at step 1 in
+  summary.json's `solver_switches` (empty with Saddle Point named), and every step's capstan
   force equal to the run with `Pressure Update = Saddle Point` from the start (1e-8 of
   the largest force); the same on 2 ranks, its forces those of 1 rank (1e-8).
 - `Pressure Update = Anderson` named: exit 2 at step 1 (nothing switches a named update),
   so the fallback is what rescues the run.
 - A checkpoint after the switch (3 steps, Checkpoint Every = 2) restarts with the
   saddle-point step and its carried stop-rule state: step 3 as the uninterrupted run's,
-  the same Newton iterations and forces to 1e-10.
+  the same Newton iterations and forces to 1e-10, and the switch still listed.
 """
 import json
 import os
@@ -40,6 +41,10 @@ T.conforms(out, os.path.join(out, "scene.xml"))
 p2, s2, _ = T.run_scene(SCENE, "saddle-point", sets=SOFT + ["Solver/Pressure Update=Saddle Point"])
 if T.check(s is not None and s["converged"] and s2 is not None and s2["converged"], "Auto and Saddle Point converge"):
     T.check(p.stdout.count(SWITCH) == 1, f"Auto: the switch reported once ({p.stdout.count(SWITCH)})")
+    sw = s["solver_switches"]
+    T.check(len(sw) == 1 and sw[0]["step"] == 1 and "saddle-point pressure step" in sw[0]["what"],
+            f"Auto: summary.json's solver_switches lists it at step 1 ({sw})")
+    T.check(s2["solver_switches"] == [], f"Saddle Point named: no switch listed ({s2['solver_switches']})")
     T.check(len(s["steps"]) == len(s2["steps"]) == 6, "six steps each")
     scale = max(abs(v) for f in forces(s2) for v in f)
     worst = max(abs(a - b) for fa, fb in zip(forces(s), forces(s2)) for a, b in zip(fa, fb)) / scale
@@ -74,4 +79,6 @@ if pr.returncode == 0 and whole is not None:
     fa, fb = a["capstans"]["capstan"]["force"], b["capstans"]["capstan"]["force"]
     d = max(abs(x - y) for x, y in zip(fa, fb)) / max(abs(y) for y in fb)
     T.check(d <= 1e-10, f"restarted step 3's capstan force against the uninterrupted run's: {d:.1e} (1e-10)")
+    T.check(again["solver_switches"] == whole["solver_switches"] and len(again["solver_switches"]) == 1,
+            f"the restarted run's solver_switches, carried by the checkpoint: {again['solver_switches']}")
 T.finish()

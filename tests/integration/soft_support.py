@@ -9,7 +9,8 @@ single-precision factors erred by 8% there: GMRES on them gave Newton directions
 search could use, and the run ended with exit 2 after 41 cuts at 31% of its step. The
 factorisation's probe (src/mumps_solve_factory.cpp) now switches to double precision.
 
-Checks: exit 0 with no cut and few Newton iterations; the switch is reported; the base's
+Checks: exit 0 with no cut and few Newton iterations; the switch is reported (stderr, and
+summary.json's `solver_switches` at step 1); the base's
 reaction equals the springs' k A 0.05 (the block hardly deforms: within 1e-3); and the
 same scene with Precision = Double named gives the same forces (1e-8).
 """
@@ -34,6 +35,9 @@ if ok:
     cuts = sum(x["cutbacks"] for x in s["steps"])
     T.check(cuts == 0 and newton <= 10, f"soft foundation: {newton} Newton iterations (<= 10), {cuts} cuts (0)")
     T.check("double precision from here on" in p.stderr, "soft foundation: the switch to double factors is reported")
+    sw = s["solver_switches"]
+    T.check(len(sw) == 1 and sw[0]["step"] == 1 and "double precision" in sw[0]["what"],
+            f"soft foundation: summary.json's solver_switches lists it at step 1 ({sw})")
     fy, expected = st["supports"]["base"]["force"][1], 1.3749e-4 * 1.0 * 0.05
     T.check(abs(fy - expected) <= 1e-3 * expected, f"soft foundation: base reaction {fy:.6e} = k A 0.05 = {expected:.6e}")
     p2, s2, out2 = T.run_scene(T.input("block40.xml"), "soft-double",
@@ -41,5 +45,6 @@ if ok:
     if T.check(s2 is not None and s2["converged"], "soft foundation, Precision = Double: converged"):
         f1, f2 = st["supports"]["top"]["force"][1], s2["steps"][-1]["supports"]["top"]["force"][1]
         T.check(abs(f1 - f2) <= 1e-8 * abs(f2), f"soft foundation: top force {f1:.10e} against Double's {f2:.10e}")
-        T.check("double precision from here on" not in p2.stderr, "Precision = Double named: nothing to report")
+        T.check("double precision from here on" not in p2.stderr and s2["solver_switches"] == [],
+                "Precision = Double named: nothing to report")
 T.finish()
