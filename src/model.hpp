@@ -52,7 +52,7 @@ struct Model {
     restoreState(effects(), s.effects);
   }
   // The saddle-point pressure step (Solver/Pressure Update), also built mid-run where Auto's
-  // Anderson loop fails (AugmentationLoop::solve).
+  // Anderson loop fails a step through every cut (LoadStepper::advance).
   void buildPressureStep();
   // Newton's linear solves and the pressure steps' block solves.
   double linearSolveSeconds() const;
