@@ -62,6 +62,10 @@ class Assembly {
   // Turns the whole body, with each rigid core whose rotation is free, rigidly
   // about the core's axis by dTheta[core] (a rolling body's first guess).
   void rollWithCores(Vector& u, const std::vector<double>& dTheta);
+  // Translates the whole body with rigid core c by delta (its free components).
+  void translateWithCore(Vector& u, size_t c, const std::array<double, 3>& delta) {
+    cores_.translate(u.getDataNonConst(), c, delta);
+  }
   // Sets the constrained entries of u to their values at time t, and the rigid
   // cores' face nodes to where the cores' values in u put them.
   void applyConstraints(Vector& u, double t);

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "rolling.hpp"
+#include "seating.hpp"
 
 namespace capstan {
 
@@ -29,6 +30,8 @@ double Predictors::firstGuess(double t0, double t, StepRecord& rec) {
     assembly.evaluate(plain, &f, nullptr);
     bare = f.norm2();
   }
+  // A fresh run's first increment: a body that the capstans overlap deeply moved clear first.
+  if (t0 == 0 && !previous_) seat(t, bare);
   // In steady rolling every increment looks like the one before (the nip has
   // moved on by one increment of the roller's turn), which the linear response
   // from a state at rest cannot see: the shape shifted along the streamlines,
@@ -50,6 +53,15 @@ double Predictors::firstGuess(double t0, double t, StepRecord& rec) {
     tangent(t0, t, bare, rec, rolled);
   assembly.applyConstraints(*m_.u, t);
   return bare;
+}
+
+void Predictors::seat(double t, double bare) {
+  const double moved = seatFreeCore(m_, log_, t, bare);
+  if (moved > 0 && !seated_)
+    log_.progress(format("  step 1: the capstans overlap the body by more than %g of a contact face edge: the body "
+                         "moved %.4g clear with its core as the first guess",
+                         kSeatingOverlap, moved));
+  seated_ = seated_ || moved > 0;
 }
 
 void Predictors::linearResponse(double t, StepRecord& rec) {

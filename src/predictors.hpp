@@ -37,6 +37,9 @@ class Predictors {
   void linearResponse(double t, StepRecord& rec);
 
  private:
+  // A fresh run's first increment: the body seated clear of a deep overlap (src/seating.hpp), said
+  // on the progress lines once.
+  void seat(double t, double bare);
   // Rolling: u extrapolated along the last converged increment; true if kept.
   bool extrapolate(double t0, double t1, double bare, Vector& f);
   // Rolling: each free core's turn in the increment, at its last angular
@@ -62,6 +65,7 @@ class Predictors {
   double tPrevious_ = 0;
   std::vector<double> previousRotation_;  // the cores' rotations in that state
   std::unique_ptr<StreamlineShift> shift_;  // built at its first use
+  bool seated_ = false;
 };
 
 }  // namespace capstan

@@ -72,6 +72,13 @@ void RigidCores::roll(const Teuchos::ArrayRCP<double>& data, const std::vector<d
   }
 }
 
+void RigidCores::translate(const Teuchos::ArrayRCP<double>& data, size_t c, const std::array<double, 3>& delta) const {
+  for (size_t n = 0; n < mesh_.numOwnedNodes; ++n)
+    for (int i = 0; i < 3; ++i) data[3 * n + i] += delta[i];
+  if (layout_.coresOwned)
+    for (int i = 0; i < 3; ++i) data[3 * mesh_.numOwnedNodes + kCoreUnknowns * c + i] += delta[i];
+}
+
 std::vector<std::array<double, 5>> RigidCores::sums(const double* v) const {
   const size_t nc = cores_.size();
   std::vector<double> local(5 * nc, 0.0), global(5 * nc, 0.0);

@@ -95,6 +95,8 @@ class RigidCores {
   // Turns the whole body (owned values of u), with each core whose rotation is
   // free, rigidly about the core's axis by dTheta[core], and that core's theta.
   void roll(const Teuchos::ArrayRCP<double>& u, const std::vector<double>& dTheta) const;
+  // Translates the whole body (owned values of u) and core c's translation by delta.
+  void translate(const Teuchos::ArrayRCP<double>& u, size_t c, const std::array<double, 3>& delta) const;
 
   // Sums over the owned core nodes of v (owned values, a residual or K z): per
   // core {force (3), torque, R . w}, global (collective).

@@ -46,6 +46,7 @@ ContactEffect::ContactEffect(const std::string& name, const Mesh& mesh, const st
     }
   double hMin = h;
   Teuchos::reduceAll(*mesh.comm, Teuchos::REDUCE_MIN, h, Teuchos::outArg(hMin));
+  shortestEdge_ = hMin;
   tolerance_ = settings.penetrationTolerance > 0 ? settings.penetrationTolerance : 1e-4 * hMin;
   capstan_.contact.quadrature = settings.resolvedQuadrature(hMin, c, exactStick);
   // A Gauss rule the scene names where Auto would take the nodal one.

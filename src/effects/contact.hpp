@@ -68,6 +68,8 @@ class ContactEffect : public Effect {
                   std::vector<double>& traction) const;
   const std::array<double, 3>& axisDirection() const { return beta_; }
   double radius() const { return capstan_.radius; }
+  // The shortest candidate face edge over all ranks (the mesh's scale at the contact).
+  double shortestEdge() const { return shortestEdge_; }
   // Predictor: the contact tangent without its geometric stiffness (see
   // kernels/contact.hpp).
   void setPredicting(bool on) override { predicting_ = on; }
@@ -95,6 +97,7 @@ class ContactEffect : public Effect {
   // Per face and point at the last evaluation: gap, pressure, weight, area, e (3), x (3).
   Points points_;
   CapstanSpec capstan_;
+  double shortestEdge_ = 0;
   double tolerance_ = 0;          // on eps |t_n - lambda| (length), resolved against the mesh
   std::array<double, 3> beta_{};  // unit axis direction
   double time_ = 0;
