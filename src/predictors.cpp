@@ -58,9 +58,9 @@ double Predictors::firstGuess(double t0, double t, StepRecord& rec) {
 void Predictors::seat(double t, double bare) {
   const double moved = seatFreeCore(m_, log_, t, bare);
   if (moved > 0 && !seated_)
-    log_.progress(format("  step 1: the capstans overlap the body by more than %g of a contact face edge: the body "
-                         "moved %.4g clear with its core as the first guess",
-                         kSeatingOverlap, moved));
+    log_.progress(format("  step 1: the capstans overlap the body by more than its shortest contact face edge: the "
+                         "body moved %.4g clear with its core as the first guess",
+                         moved));
   seated_ = seated_ || moved > 0;
 }
 
