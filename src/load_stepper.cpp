@@ -125,6 +125,7 @@ bool LoadStepper::advance(StepRecord& rec, std::string& failure) {
                                     : format(" failed after %d cuts, %.3g of its %.3g done", rec.cutbacks,
                                              tDone_ - tStep, rec.time - tStep)) +
                 ": " + why + brakeDiagnosis(m_.scene) + stickChatterHint(m_.scene, why);
+      if (const std::string rollOff = rollOffDiagnosis(m_.scene); !rollOff.empty()) failure += "; " + rollOff;
       m_.restore(atStep);
       tDone_ = tStep;
       assembly.setInterval(tDone_, tDone_);

@@ -1,6 +1,7 @@
 #include "rolling.hpp"
 
 #include <cmath>
+#include <vector>
 
 #include "assembly.hpp"
 #include "errors.hpp"
@@ -35,6 +36,39 @@ std::string brakeDiagnosis(const Scene& scene) {
              " exceeds what friction in the nip can carry (mu |Force| R = " + brief(mu) + " x " + brief(F) +
              " x " + brief(scene.mesh.outerRadius) + " = " + brief(capacity) +
              "): there is no quasi-static equilibrium, the roller would stop and the capstan slip";
+  }
+  return out;
+}
+
+std::string rollOffDiagnosis(const Scene& scene) {
+  if (scene.mesh.type != MeshSpec::Type::Annulus || scene.capstans.size() != 1) return "";
+  const auto& c = scene.capstans[0];
+  const Vec3 a = unit(c.axisDirection);
+  std::string out;
+  for (const auto& s : scene.supports) {
+    if (!s.isCore() || s.rotation != SupportSpec::Rotation::Free) continue;
+    if (!(norm(cross(Vec3{s.force[0], s.force[1], s.force[2]}, a)) > 0)) continue;  // no force across the axis
+    // Free in two independent directions normal to the capstan's axis: the core can move round
+    // the capstan. Along one line only (the shipped rollers: y) it is held on that line.
+    std::string free;
+    std::vector<Vec3> normal;
+    for (int i = 0; i < 3; ++i)
+      if (s.freeTranslation[i]) {
+        Vec3 e{i == 0 ? 1.0 : 0.0, i == 1 ? 1.0 : 0.0, i == 2 ? 1.0 : 0.0};
+        const double along = dot(e, a);
+        for (int k = 0; k < 3; ++k) e[k] -= along * a[k];
+        free += char('x' + i), normal.push_back(e);
+      }
+    bool plane = false;
+    for (size_t i = 0; i < normal.size(); ++i)
+      for (size_t j = i + 1; j < normal.size(); ++j) plane = plane || norm(cross(normal[i], normal[j])) > 1e-6;
+    if (!plane) continue;
+    out += std::string(out.empty() ? "" : "; ") + "support '" + s.name + "': free to turn and free along " + free +
+           ", so free to move round capstan '" + c.name +
+           "': pressed onto one capstan by a force of fixed direction, a free roller's only position of rest is "
+           "unstable (it rolls off the capstan, as a ball off the top of a dome), and a solve that starts beside "
+           "it does not converge; hold one of " + free +
+           " (as a pinch roller's arm keeps the roller on its arc)";
   }
   return out;
 }

@@ -24,6 +24,7 @@
 #include "log.hpp"
 #include "mesh.hpp"
 #include "parameters.hpp"
+#include "rolling.hpp"
 #include "vec3.hpp"
 
 namespace capstan {
@@ -899,6 +900,8 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
   // annulus axis is that axis' fault, not the core's it cannot push.
   AnalysisSettings::checkScene(sc, v);
   rejectSingularCores(sc, v);
+  if (const std::string rollOff = rollOffDiagnosis(sc); !rollOff.empty())
+    sc.warnings.push_back(sc.file + ": parameter 'Supports': " + rollOff);
   for (auto& s : sc.supports)
     if (s.isCore() && s.rampTime == 0) s.rampTime = sc.stepSize;
   for (auto& s : sc.supports)

@@ -37,6 +37,13 @@ its mirror images at x = 2.75 and z = 3 (formulation.md's G1 is symmetric about 
 and z = 2; which one round-off names differs between machines). Cases A-D are
 not distorted (det F above 0.5 everywhere), and their failures say nothing of it.
 
+Case F, a free roller that rolls off: the rolling slice with its core free along x and y
+and pressed by a force with a small side component, {-0.02, -0.25, 0}. On one capstan a
+roller free to turn and to move round it has one position of rest, unstable (as a ball on
+the top of a dome): step 1 fails. The scene warns of it (also from `capstan validate`),
+and the failure says the same, with what to hold; the shipped slice (free along y only)
+gets no such warning.
+
 Checks, every case: exit status 2; summary.json has "converged": false, a
 non-empty "failure", no NaN or infinity anywhere, and passes check_summary.py;
 history.csv, fields.xmf and fields.h5 exist and hold exactly the converged
@@ -178,7 +185,24 @@ T.check(m is not None and abs(float(m.group(1)) - 0.48) < 0.01 and len(at) == 3
         and min(abs(at[0] - 4.25), abs(at[0] - 2.75)) < 1e-9 and abs(at[1] - 1.53125) < 1e-3
         and min(abs(at[2] - 1), abs(at[2] - 3)) < 1e-9,
         f"E: the failure names the most distorted element: {sE['failure']!r}")
-for label, sx in (("A", sA), ("B", sB), ("C", sC), ("D", sD)):
+
+# --- Case F: a free roller rolls off its capstan -----------------------------------
+print("\n  --- case F: the slice free along x and y, pressed a little sideways")
+ROLL_OFF = ["Supports/core/Free Translation=xy", "Supports/core/Force={-0.02, -0.25, 0}"]
+sF, outF, fF = common("F-roll-off", ["Time/Steps=1"] + ROLL_OFF, min_steps=0,
+                      scene_file=T.input("pinch-roller-slice.xml"), resolved=True)
+T.check("rolls off the capstan" in sF["failure"] and "hold one of xy" in sF["failure"],
+        f"F: the failure says the roller rolls off and what to hold: {sF['failure']!r}")
+for label, sets in (("F", ROLL_OFF), ("the shipped slice", [])):
+    args = ["validate", T.input("pinch-roller-slice.xml")]
+    for x in sets:
+        args += ["--set", x]
+    p = T.capstan_run(args)
+    warned = "rolls off the capstan" in p.stderr and "parameter 'Supports'" in p.stderr
+    T.check(p.returncode == 0 and warned == bool(sets),
+            f"{label}: capstan validate exits 0, {'with' if sets else 'without'} the roll-off warning")
+
+for label, sx in (("A", sA), ("B", sB), ("C", sC), ("D", sD), ("F", sF)):
     T.check("det F" not in sx["failure"], f"{label}: no distortion note: {sx['failure']!r}")
 
 T.finish()
