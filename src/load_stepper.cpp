@@ -94,15 +94,18 @@ bool LoadStepper::advance(StepRecord& rec, std::string& failure) {
     // of a 1e-3 s step: half the force first; docs/steady-rolling.md).
     const double rampLeft = steady ? loadRampLeft(assembly, tDone_) : 0;
     if (rampLeft > 0 && h >= rampLeft) h = rampLeft / 2;
-    // How much of the step is done: a run of cuts to the same dt is then seen to advance.
-    log_.progress(format("  step %d, %.3g of it done: cut back to dt = %.4g (%s)", rec.step,
-                         (tDone_ - tStep) / (rec.time - tStep), h, why.c_str()));
-    const std::string hint = chatterHinted_ ? std::string() : stickChatterHint(m_.scene, why);
-    if (!hint.empty()) {
-      chatterHinted_ = true;  // once a run: the hint, before the cuts' retries
-      log_.progress("  " + hint.substr(2));
-    }
     const bool lastTry = h < minimumSubstep || rec.cutbacks - cutsBefore > kMostCutsPerStep;
+    if (!lastTry) {
+      // How much of the step is done: a run of cuts to the same dt is then seen to advance. (After
+      // the last try the failure speaks instead: no cut it would not take.)
+      log_.progress(format("  step %d, %.3g of it done: cut back to dt = %.4g (%s)", rec.step,
+                           (tDone_ - tStep) / (rec.time - tStep), h, why.c_str()));
+      const std::string hint = chatterHinted_ ? std::string() : stickChatterHint(m_.scene, why);
+      if (!hint.empty()) {
+        chatterHinted_ = true;  // once a run: the hint, before the cuts' retries
+        log_.progress("  " + hint.substr(2));
+      }
+    }
     if (lastTry && andersonMayFail && !m_.pressureStep) {
       // Auto's Anderson loop failed the step through every cut, where the saddle-point step can
       // converge (a soft stick: docs/numerics.md): the step again with it, kept from here on.

@@ -27,7 +27,9 @@ std::string brakeDiagnosis(const Scene& scene) {
     if (!s.isCore() || s.rotation != SupportSpec::Rotation::Free || s.torque == 0) continue;
     // Friction at most mu |t_n| everywhere, at most the outer radius from the
     // axis: the nip carries at most sum mu |F| R_outer about the core's axis.
+    // A held core (no Force) presses by the overlap the scene gives it, which only the solve knows.
     const double F = norm(s.force);
+    if (F == 0) continue;
     double mu = 0;
     for (const auto& c : scene.capstans) mu += c.friction.on() ? c.friction.coefficient : 0.0;
     const double capacity = mu * F * scene.mesh.outerRadius;
@@ -82,11 +84,14 @@ std::string stickChatterHint(const Scene& scene, const std::string& failure) {
     // item 11); where the loop still stalls, these converged on the meshes
     // measured (docs/steady-rolling.md, "Stick and slip that cycle").
     const double speed = std::fabs(c.angularVelocity * c.radius);
+    // Tanh's scale from the capstan's surface speed; a capstan that does not spin gives none.
+    const std::string tanh = speed > 0 ? ", or Friction/Law = Tanh with Regularization " + brief(1e-3 * speed) +
+                                             " (1e-3 x the capstan's surface speed),"
+                                       : "";
     return "; capstan '" + c.name + "': Coulomb's stick and slip may not settle on this mesh (with --log newton, " +
            "the pressure step's contact and stick rows change from pass to pass): a nip of many fine cells over " +
            "an outer radial cell thicker than the contact's half-width makes them chatter; more radial cells " +
-           "under the nip, or Friction/Law = Tanh with Regularization " + brief(1e-3 * speed) +
-           " (1e-3 x the capstan's surface speed), converge (docs/steady-rolling.md, \"Stick and slip that cycle\")";
+           "under the nip" + tanh + " converge (docs/steady-rolling.md, \"Stick and slip that cycle\")";
   }
   return "";
 }

@@ -9,10 +9,13 @@ namespace capstan {
 namespace {
 
 // The one rigid core that may carry the whole body: the scene's only core, translating freely
-// along some direction that no other support holds. -1 where there is none.
+// along some direction that no other support holds, against the scene's only capstan. With two,
+// the overlaps on the contact faces cannot see a capstan the body is moved through: on the fast
+// roller with a second capstan across it, the body moved 4.9 and ended with that capstan inside
+// its coating (the sweep of 2026-12-07). -1 where there is none.
 int seatableCore(const Model& m) {
   const auto& cores = m.assembly->rigidCores();
-  if (cores.size() != 1 || m.assembly->contacts().empty()) return -1;
+  if (cores.size() != 1 || m.assembly->contacts().size() != 1) return -1;
   const auto& core = cores[0];
   if (!(core.free[0] || core.free[1] || core.free[2])) return -1;
   for (const auto& s : m.scene.supports)
@@ -65,12 +68,12 @@ double seatFreeCore(Model& m, Log& log, double t, double bare) {
     return trial;
   };
   // Bracket the translation that leaves the target overlap, then bisect: the overlap falls as the
-  // body moves away (where it does not, the capstans surround the body: no seating).
+  // body moves away. A move longer than 4x the overlap (the push 75 degrees or more off the
+  // capstan's normal) is no seating: none.
   double lo = 0, hi = overlap - target;
-  int doublings = 0;
   while (largestOverlap(m, moved(hi)) > target) {
     lo = hi, hi *= 2;
-    if (++doublings > 8) return 0;
+    if (hi > 4 * overlap) return 0;
   }
   for (int k = 0; k < 40 && hi - lo > 1e-3 * target; ++k) {
     const double mid = 0.5 * (lo + hi);

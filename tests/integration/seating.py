@@ -15,6 +15,10 @@ exit 2. Now the body moves clear with its core first (the first guess only):
     away (Axis Point y = -11.44, an overlap of about 0.01, not seated), the capstan force
     within 1e-8 (relative) and the core's translation 0.2 apart to 1e-8;
   * 2 ranks give 1 rank's force and translation to 1e-8;
+  * a body between two capstans is not seated: the fast roller (inputs/free-roller-fast.xml)
+    overlapped 0.3 by its capstan, with a second capstan across it. Seated, it moved 4.9,
+    through the second capstan, and converged with that capstan inside its coating; now
+    it converges where both capstans touch the body;
   * designed preloads are not seated: the shipped Hertz ring (overlap 0.01, 0.28 of its
     edge) and the 3D drive's step 1 (0.06, 0.66 of its edge).
 """
@@ -70,6 +74,18 @@ if tilted and away and two and tilted["converged"] and away["converged"] and two
 _, shipped, out = T.run_scene(SCENE, "shipped", extra=["--log", "newton"])
 T.check(shipped is not None and shipped["converged"] and not T.log_events(out, "seating"),
         "the shipped Hertz ring (overlap 0.28 of the edge): converged, not seated")
+C2 = "Capstans/c2/"
+TWO = ["Time/Steps=1", "Capstans/capstan/Axis Point={0, -8.39, 0}", C2 + "Radius=2.5", C2 + "Axis Point={0, 8.69, 0}",
+       C2 + "Contact Faces=outer", C2 + "Contact/Method=Augmented Lagrangian"]
+_, two, out = T.run_scene(T.input("free-roller-fast.xml"), "two-capstans", sets=TWO, extra=["--log", "newton"])
+if two is not None and two["converged"]:
+    points = {k: v["contact_points"] for k, v in two["steps"][-1]["capstans"].items()}
+    q = two["steps"][-1]["supports"]["core"]["translation"]
+    T.check(not T.log_events(out, "seating") and all(n > 0 for n in points.values()) and abs(q[1]) < 1,
+            f"between two capstans: not seated, both capstans touch the body {points}, core moved {q[1]:.3f}")
+else:
+    T.check(False, f"between two capstans: converged ({None if two is None else two['failure']!r})")
+
 _, drive, out = T.run_scene(T.input("pinch-roller.xml"), "drive", sets=["Time/Steps=1", "Output/Write Fields=false"],
                             extra=["--log", "newton"])
 T.check(drive is not None and drive["converged"] and not T.log_events(out, "seating"),
