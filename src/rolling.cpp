@@ -48,7 +48,10 @@ std::string rollOffDiagnosis(const Scene& scene) {
   const Vec3 a = unit(c.axisDirection);
   std::string out;
   for (const auto& s : scene.supports) {
-    if (!s.isCore() || s.rotation != SupportSpec::Rotation::Free) continue;
+    // Friction holds a core that does not turn; one that turns rolls, one on a capstan without
+    // friction slides.
+    const bool rolls = s.rotation == SupportSpec::Rotation::Free, slides = !c.friction.grips();
+    if (!s.isCore() || !(rolls || slides)) continue;
     if (!(norm(cross(Vec3{s.force[0], s.force[1], s.force[2]}, a)) > 0)) continue;  // no force across the axis
     // Free in two independent directions normal to the capstan's axis: the core can move round
     // the capstan. Along one line only (the shipped rollers: y) it is held on that line.
@@ -65,12 +68,13 @@ std::string rollOffDiagnosis(const Scene& scene) {
     for (size_t i = 0; i < normal.size(); ++i)
       for (size_t j = i + 1; j < normal.size(); ++j) plane = plane || norm(cross(normal[i], normal[j])) > 1e-6;
     if (!plane) continue;
-    out += std::string(out.empty() ? "" : "; ") + "support '" + s.name + "': free to turn and free along " + free +
+    out += std::string(out.empty() ? "" : "; ") + "support '" + s.name + "': " +
+           (rolls ? "free to turn" : "on a capstan without friction") + " and free along " + free +
            ", so free to move round capstan '" + c.name +
-           "': pressed onto one capstan by a force of fixed direction, a free roller's only position of rest is "
-           "unstable (it rolls off the capstan, as a ball off the top of a dome), and a solve that starts beside "
-           "it does not converge; hold one of " + free +
-           " (as a pinch roller's arm keeps the roller on its arc)";
+           "': pressed onto one capstan by a force of fixed direction, its only position of rest is unstable (it " +
+           (rolls ? "rolls" : "slides") +
+           " off the capstan, as a ball off the top of a dome), and a solve that starts beside it does not "
+           "converge; hold one of " + free + " (as a pinch roller's arm keeps the roller on its arc)";
   }
   return out;
 }

@@ -21,9 +21,10 @@ double noSlipAngularVelocity(const Scene& scene, const RigidCore& core);
 // what friction in the nip can carry ("; support ...: ..."), or empty.
 std::string brakeDiagnosis(const Scene& scene);
 
-// Why a free roller may find no position of rest: a core free to turn, pressed by its Force onto
-// the scene's only capstan and free to translate in two directions normal to the capstan's axis,
-// rolls off the capstan, as a ball off the top of a dome (its one position of rest is unstable). The description
+// Why a free roller may find no position of rest: a core free to turn (or on a capstan without
+// friction), pressed by its Force onto the scene's only capstan and free to translate in two
+// directions normal to the capstan's axis, rolls (slides) off the capstan, as a ball off the top
+// of a dome (its one position of rest is unstable). The description
 // ("support ...: ..."), or empty; the scene warns of it and a failed run repeats it.
 std::string rollOffDiagnosis(const Scene& scene);
 
