@@ -371,6 +371,7 @@ void AugmentationLoop::moveByPressureStep(double t, Vector& f, const Constraints
   }
   beforeStep = StepStart{m_.snapshot(), pressureNext};
   if (!saddlePointPressureStep(t, f, c.volumeMet, stepAlone, rec)) {  // no progress: a plain pass instead
+    m_.restore(beforeStep->at);  // a step that inverted an element even at its shortest moved u
     setMultipliers(effects, pressureNext, true);
     beforeStep.reset();
     passes.newtonNext();
@@ -466,13 +467,7 @@ bool AugmentationLoop::saddlePointPressureStep(double t, Vector& f, bool volumeM
       if (assembly.evaluate(*m_.u, &f, nullptr)) break;
       // Even its shortest length inverts an element: Newton from there solved on a meaningless
       // tangent and failed (the Hertz ring pressed 400x harder: 2,000 GMRES iterations, 17 s,
-      // each time). No step: a plain pass from where it started.
-      m_.u->update(1.0, u0, 0.0);
-      for (size_t i = 0; i < assembly.effects().size(); ++i) {
-        auto mu = assembly.effects()[i]->multipliers();
-        if (mu.extent(0) == mu0[i].extent(0)) Kokkos::deep_copy(mu, mu0[i]);
-      }
-      assembly.evaluate(*m_.u, &f, nullptr);
+      // each time). No step: the caller goes back to where it started.
       if (log_.on("newton"))
         log_.event("newton", format("pressure step %.4g inverts an element: not taken", alpha),
                    eventOf("pressure_step_inverts"));

@@ -30,7 +30,7 @@ double Predictors::firstGuess(double t0, double t, StepRecord& rec) {
     assembly.evaluate(plain, &f, nullptr);
     bare = f.norm2();
   }
-  // A fresh run's first increment: a body that the capstans overlap deeply moved clear first.
+  // A fresh run's first increment: a body that the capstan overlaps deeply moved clear first.
   if (t0 == 0 && !previous_) seat(t, bare);
   // In steady rolling every increment looks like the one before (the nip has
   // moved on by one increment of the roller's turn), which the linear response
@@ -58,7 +58,7 @@ double Predictors::firstGuess(double t0, double t, StepRecord& rec) {
 void Predictors::seat(double t, double bare) {
   const double moved = seatFreeCore(m_, log_, t, bare);
   if (moved > 0 && !seated_)
-    log_.progress(format("  step 1: the capstans overlap the body by more than its shortest contact face edge: the "
+    log_.progress(format("  step 1: the capstan overlaps the body by more than its shortest contact face edge: the "
                          "body moved %.4g clear with its core as the first guess",
                          moved));
   seated_ = seated_ || moved > 0;

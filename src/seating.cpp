@@ -25,16 +25,11 @@ int seatableCore(const Model& m) {
   return 0;
 }
 
-// The largest overlap of any capstan with the body at u (collective), and the capstans' force on
-// the body.
+// The capstan's largest overlap with the body at u (collective), and its force on the body.
 double largestOverlap(Model& m, const Vector& u, std::array<double, 3>* forceOnBody = nullptr) {
   m.assembly->evaluate(u, nullptr, nullptr);
-  double local[4] = {0, 0, 0, 0};
-  for (const auto* c : m.assembly->contacts()) {
-    const auto fig = c->figures({0, 0, 0});
-    local[0] = std::max(local[0], fig.maxPenetration);
-    for (int i = 0; i < 3; ++i) local[1 + i] -= fig.force[i];
-  }
+  const auto fig = m.assembly->contacts()[0]->figures({0, 0, 0});
+  double local[4] = {fig.maxPenetration, -fig.force[0], -fig.force[1], -fig.force[2]};
   double overlap = 0, force[3];
   Teuchos::reduceAll(*m.comm, Teuchos::REDUCE_MAX, local[0], Teuchos::outArg(overlap));
   Teuchos::reduceAll(*m.comm, Teuchos::REDUCE_SUM, 3, local + 1, force);
@@ -47,13 +42,12 @@ double largestOverlap(Model& m, const Vector& u, std::array<double, 3>* forceOnB
 double seatFreeCore(Model& m, Log& log, double t, double bare) {
   const int c = seatableCore(m);
   if (c < 0) return 0;
-  double edge = 1e300;
-  for (const auto* contact : m.assembly->contacts()) edge = std::min(edge, contact->shortestEdge());
   auto& assembly = *m.assembly;
+  const double edge = assembly.contacts()[0]->shortestEdge();
   std::array<double, 3> force{};
   const double overlap = largestOverlap(m, *m.u, &force);
   if (!(overlap > kSeatingOverlap * edge)) return 0;
-  // Along the capstans' push on the body, within the core's free directions.
+  // Along the capstan's push on the body, within the core's free directions.
   std::array<double, 3> n{};
   double length = 0;
   for (int i = 0; i < 3; ++i) n[i] = assembly.rigidCores()[c].free[i] ? force[i] : 0.0, length += n[i] * n[i];

@@ -1,4 +1,4 @@
-// A free core's body seated against the capstans before the first step. A scene can start with a
+// A free core's body seated against its capstan before the first step. A scene can start with a
 // capstan overlapping the body by far more than its surface cells are thick (a tilted capstan axis
 // turns the Hertz ring's 0.01 overlap into 0.21 at one end). The first Newton solve must then
 // squeeze that overlap out of the thin cells at the surface, and fails at every cut: a cut does
