@@ -87,6 +87,14 @@ bool parse(int argc, char** argv, Args& a, std::string& error) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Before Kokkos starts: it answers --help with its own options' page.
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--help" || arg == "-h" || (i == 1 && arg == "help")) {
+      std::cout << kUsage;
+      return 0;
+    }
+  }
   capstan::reexecWithHeapTunables(argv);  // before MPI starts (src/heap_tunables.hpp)
   Tpetra::ScopeGuard tpetra(&argc, &argv);
   auto comm = Tpetra::getDefaultComm();
@@ -111,10 +119,6 @@ int main(int argc, char** argv) {
                    "default there):\n";
       capstan::validMumpsOptions()->print(std::cout, options);
     }
-    return 0;
-  }
-  if (args.command == "--help" || args.command == "help") {
-    if (rank0) std::cout << kUsage;
     return 0;
   }
   if (args.command != "run" && args.command != "validate") {

@@ -5,7 +5,8 @@ Bad input exits 1, the message on stderr names the scene file and the parameter
 path, and nothing is written (the output directory is not created; the working
 directory gains nothing): malformed XML, an unknown parameter, a wrong type,
 Cells with a 0, a missing scene file, an unwritable output directory, a bad
---set; also on 2 ranks. Then: `capstan --version` exits 0, `capstan params`
+--set; also on 2 ranks. Then: `capstan --version` exits 0, `--help` prints
+capstan's usage (not Kokkos' options page), `capstan params`
 prints "Pressure Penalty", `capstan validate inputs/uniaxial.xml` exits 0 and
 writes nothing.
 """
@@ -110,6 +111,11 @@ bad_input("validate, unknown parameter", ["validate", os.path.join(scenes, "unkn
 p = T.capstan_run(["--version"], cwd=work)
 T.check(p.returncode == 0 and p.stdout.strip() != "",
         f"capstan --version: exit {p.returncode}, prints {p.stdout.strip()!r}")
+for args in (["--help"], ["run", "-h"]):
+    p = T.capstan_run(args, cwd=work)
+    T.check(p.returncode == 0 and p.stdout.startswith("usage: capstan run") and "kokkos" not in p.stdout.lower(),
+            f"capstan {' '.join(args)}: exit {p.returncode}, capstan's usage alone (not Kokkos' options): "
+            f"{p.stdout[:80]!r}")
 p = T.capstan_run(["params"], cwd=work)
 T.check(p.returncode == 0, f"capstan params: exit {p.returncode}")
 T.check("Pressure Penalty" in p.stdout, f"capstan params prints 'Pressure Penalty' ({len(p.stdout)} characters)")
