@@ -125,6 +125,9 @@ bool AugmentationLoop::solveOnce(double t, double bare, StepRecord& rec, std::st
                      eventOf("pressure_step_undone").add("failed_iterations", json::number(r.iterations)));
         m_.restore(beforeStep->at);
         setMultipliers(m_.assembly->effects(), beforeStep->pressureNext, true);
+        // The kept preconditioner was factored in the failed solve, far from here: the
+        // next pressure step's GMRES ran to its limit on it (the Hertz ring pressed 400x).
+        m_.newton->rebuildPreconditioner();
         beforeStep.reset();
         continue;
       }

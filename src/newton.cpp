@@ -12,6 +12,7 @@
 #include <Thyra_StateFuncModelEvaluatorBase.hpp>
 #include <Thyra_TpetraThyraWrappers.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -96,6 +97,11 @@ class LagPolicy {
     }
     if (iterations >= maxIterations_ || iterations > growth_ * baseline_ + slack_) factory_.requestRebuild();
   }
+  // A preconditioner built for the saddle-point step, at the state before it: the
+  // step moves the state, so Newton's next solve is no measure of a fresh one (the
+  // Hertz ring pressed 400x took that solve's 450 iterations as its baseline, and
+  // kept a useless factorisation for ten Newton iterations).
+  void builtOutsideNewton() { buildsSeen_ = factory_.builds(); }
 
  private:
   TimedPreconditionerFactory& factory_;
@@ -201,6 +207,38 @@ class History : public NOX::Observer {
 
  private:
   LagPolicy* lag_;
+};
+
+// Fails a solve whose last `window` iterations all took line-search steps of at
+// most 1/8 and did not halve |R|: a tangent that no longer describes the problem
+// (near-inverted bricks), where a cut step is cheaper than crawling on to the
+// iteration limit. The Hertz ring pressed 400x: two such tries of 28-30 iterations
+// at 234 GMRES iterations each before its cut (docs/numerics.md, "Newton's crawl").
+class Crawl : public NOX::StatusTest::Generic {
+ public:
+  explicit Crawl(int window) : window_(window) {}
+  NOX::StatusTest::StatusType checkStatus(const NOX::Solver::Generic& s, NOX::StatusTest::CheckType) override {
+    if (s.getNumIterations() == 0) norms_.clear(), steps_.clear();
+    norms_.push_back(s.getSolutionGroup().getNormF());
+    if (s.getNumIterations() > 0)
+      if (const auto* ls = dynamic_cast<const NOX::Solver::LineSearchBased*>(&s)) steps_.push_back(ls->getStepSize());
+    status_ = NOX::StatusTest::Unconverged;
+    const size_t k = steps_.size(), w = size_t(window_);
+    if (window_ > 0 && k >= w && norms_.size() == k + 1 &&
+        *std::max_element(steps_.end() - w, steps_.end()) <= kCrawlStep && norms_[k] > 0.5 * norms_[k - w])
+      status_ = NOX::StatusTest::Failed;
+    return status_;
+  }
+  NOX::StatusTest::StatusType getStatus() const override { return status_; }
+  std::ostream& print(std::ostream& o, int indent = 0) const override {
+    return o << std::string(indent, ' ') << status_ << "Crawl (" << window_ << " short steps)\n";
+  }
+
+ private:
+  static constexpr double kCrawlStep = 0.125;
+  int window_;
+  std::vector<double> norms_, steps_;
+  NOX::StatusTest::StatusType status_ = NOX::StatusTest::Unconverged;
 };
 
 }  // namespace
@@ -399,6 +437,7 @@ std::function<void(const Vector&, Vector&)> NewtonSolver::approximateInverse(boo
     // Lagged (Preconditioner Reuse = Adaptive): keeps the one Newton built.
     impl_->newtonPrecFactory->initializePrec(Thyra::defaultLinearOpSource<double>(impl_->W), impl_->prec.get(),
                                              Thyra::SUPPORT_SOLVE_UNSPECIFIED);
+    if (impl_->lag) impl_->lag->builtOutsideNewton();
     *seconds += timer.seconds();
     RCP<const Thyra::LinearOpBase<double>> op = impl_->prec->getUnspecifiedPrecOp();
     if (op.is_null()) op = impl_->prec->getRightPrecOp();
@@ -566,11 +605,13 @@ NewtonResult NewtonSolver::solve(Vector& u, double tolerance) {
   auto maxIters = rcp(new NOX::StatusTest::MaxIters(impl_->solver.maxNewtonIterations));
   auto finite = rcp(new NOX::StatusTest::FiniteValue);
   auto stagnation = rcp(new NOX::StatusTest::Stagnation(5, 0.999));
+  auto crawl = rcp(new Crawl(impl_->solver.crawlIterations));
   auto tests = rcp(new NOX::StatusTest::Combo(NOX::StatusTest::Combo::OR));
   tests->addStatusTest(finite);
   tests->addStatusTest(normF);
   tests->addStatusTest(maxIters);
   tests->addStatusTest(stagnation);
+  tests->addStatusTest(crawl);
 
   NewtonResult r;
   NOX::StatusTest::StatusType status = NOX::StatusTest::Failed;
@@ -615,6 +656,9 @@ NewtonResult NewtonSolver::solve(Vector& u, double tolerance) {
     if (finite->getStatus() == NOX::StatusTest::Failed) r.failure = "residual is not finite (NaN/Inf)";
     else if (maxIters->getStatus() == NOX::StatusTest::Failed) r.failure = "Newton iteration limit reached";
     else if (stagnation->getStatus() == NOX::StatusTest::Failed) r.failure = "Newton stagnated";
+    else if (crawl->getStatus() == NOX::StatusTest::Failed)
+      r.failure = format("Newton crawled (%d line-search steps of at most 1/8 in a row, |R| not halved)",
+                         impl_->solver.crawlIterations);
     else r.failure = "Newton did not converge (line search failed)";
     if (finite->getStatus() != NOX::StatusTest::Failed) r.failure += residualsReached(history->norms, tolerance);
   }

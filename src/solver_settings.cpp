@@ -154,6 +154,7 @@ SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterRe
   if (!(s.newtonAbsoluteTolerance >= 0)) r.fail("Solver/Newton Absolute Tolerance", "must be >= 0");
   s.maxNewtonIterations = r.atLeast(sol, at, "Max Newton Iterations", 0);
   if (s.maxNewtonIterations == 0) s.maxNewtonIterations = friction && (rolling || steady) ? 60 : 30;
+  s.crawlIterations = friction ? 0 : 10;
   s.predictor = r.choice(sol, at, "Predictor",
                          std::vector<std::pair<const char*, Predictor>>{{"Tangent", Predictor::Tangent},
                                                                         {"Previous", Predictor::Previous}});

@@ -36,6 +36,10 @@ struct SolverSettings {
   double newtonRelativeTolerance = 0;
   double newtonAbsoluteTolerance = 0;  // 0: 1e-13 c L^2 (Model)
   int maxNewtonIterations = 0;
+  // Newton gives up after this many iterations in a row with line-search steps of at most
+  // 1/8 that did not halve |R| (0: never): without friction, 10; with it, stick and slip
+  // sorting themselves out crawl like that and converge (NewtonSolver::solve).
+  int crawlIterations = 0;
   Predictor predictor{};
   RollingPredictor rollingPredictor{};
   LineSearch lineSearch{};
