@@ -8,7 +8,7 @@ changes a penalty). Each case must converge with no NaN, contact within its tole
 below 2e-3), max_abs_volume_change < 1e-8, bounded Newton iterations (a per-case
 budget), and a final capstan force within 1e-4 relative of the reference (1e-2 where
 points stick on the soft foundation, k = 0.01: there the answer depends on the step to
-first order).
+first order); a free core's translation too (2e-4 in steady rolling).
 
   * H5 (mu = 0.9), H4 (k = 0.1) and k = 0.01 (augmented Lagrangian, Coulomb);
   * H1 with Regularization = 1e-15 (an almost discontinuous friction law, solved as its
@@ -179,6 +179,14 @@ for i, (name, scene, sets, ref_sets, pen_tol, budget, *rest) in enumerate(CASES)
     T.check(diff <= force_tol, f"{name}: final capstan force within {diff:.1e} (<= {force_tol:.0e}) of the finely "
             f"stepped reference")
     core, ref_core = steps[-1]["supports"].get("core", {}), ref["steps"][-1]["supports"].get("core", {})
+    # A free core pressed by a force: the force balances whatever the answer; where the core
+    # sits is the answer. Steady rolling's Coulomb answers follow their path to about 1e-4
+    # there (the soft stick's retry lands 1.1e-4 away, its speed ratio within 2e-5).
+    t, t_ref = core.get("translation", [0, 0, 0]), ref_core.get("translation", [0, 0, 0])
+    if max(abs(x) for x in t_ref) > 0:
+        dt = max(abs(a - b) for a, b in zip(t, t_ref)) / max(abs(x) for x in t_ref)
+        t_tol = max(force_tol, 2e-4) if "speed_ratio" in core else force_tol
+        T.check(dt <= t_tol, f"{name}: the core's translation within {dt:.1e} (<= {t_tol:.0e}) of the reference")
     if "speed_ratio" in core:
         T.check(abs(core["speed_ratio"] - ref_core["speed_ratio"]) <= 2e-5,
                 f"{name}: speed ratio {core['speed_ratio']:.6f} against {ref_core['speed_ratio']:.6f} (2e-5)")
