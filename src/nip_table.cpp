@@ -19,9 +19,9 @@ NipTable::NipTable(const Model& model, std::filesystem::path file) : m_(model), 
   text_ = std::string(kHeader) + "\n";
 }
 
-void NipTable::open(int lastKept) {
+void NipTable::open(int lastKept, const std::filesystem::path& earlier) {
   if (!m_.rank0) return;
-  std::ifstream in(file_);
+  std::ifstream in(earlier.empty() ? file_ : earlier);
   std::string line;
   if (lastKept >= 0 && std::getline(in, line))
     while (std::getline(in, line))

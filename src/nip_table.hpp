@@ -20,8 +20,9 @@ class NipTable {
   static constexpr const char* kHeader = "step,capstan,s,z,pressure,shear,slip_rate,state";
   NipTable(const Model& model, std::filesystem::path file);
   // The file with the rows so far; a restart (lastKept >= 0) first keeps the
-  // earlier run's rows of steps up to lastKept (collective: rank 0 writes).
-  void open(int lastKept);
+  // earlier run's rows of steps up to lastKept, from `earlier` (its nip.csv; this
+  // file where empty) (collective: rank 0 writes).
+  void open(int lastKept, const std::filesystem::path& earlier = {});
   // The converged step's rows, gathered on rank 0 (collective), and the file.
   void add(int step);
 

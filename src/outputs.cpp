@@ -239,9 +239,9 @@ void Outputs::writeFields(int step, double time) {
   outputSeconds_ += since(t);
 }
 
-void Outputs::openNip(int lastKept) {
+void Outputs::openNip(int lastKept, const std::string& restartDir) {
   nip_ = std::make_unique<NipTable>(m_, dir_ / "nip.csv");
-  nip_->open(lastKept);
+  nip_->open(lastKept, restartDir.empty() ? fs::path() : fs::path(restartDir) / "nip.csv");
 }
 
 void Outputs::writeNip(int step) {

@@ -51,9 +51,9 @@ class Outputs {
   // scene.xml: the scene as this run resolved it (every default, every --set),
   // as `capstan validate` prints it: `capstan run OUT/scene.xml` runs it again.
   void writeScene();
-  // nip.csv: started (a restart keeps the earlier run's rows up to lastKept),
+  // nip.csv: started (a restart keeps the earlier run's rows up to lastKept, from restartDir),
   // then each converged step's rows (collective).
-  void openNip(int lastKept);
+  void openNip(int lastKept, const std::string& restartDir = "");
   void writeNip(int step);
   void writeSummary(const std::vector<StepRecord>& steps, const std::vector<SolverSwitch>& switches, bool converged,
                     const std::string& failure);

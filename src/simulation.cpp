@@ -94,7 +94,7 @@ class Simulation {
                            restart_->step(), restart_->time()));
     }
     outputs_->openFields(options_.restart, restart_ ? restart_->step() : -1);
-    outputs_->openNip(restart_ ? restart_->step() : -1);
+    outputs_->openNip(restart_ ? restart_->step() : -1, options_.restart);
     const double t = restart_ ? restart_->time() : 0.0;
     model_->assembly->setInterval(t, t);
     model_->assembly->evaluate(*model_->u, nullptr, nullptr);

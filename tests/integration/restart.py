@@ -23,7 +23,9 @@ The free roller slice (inputs/pinch-roller-slice.xml, 2 ranks) finished with a
 checkpoint at step 4 and restarted there: its rolling predictors extrapolate the
 last increment, which the checkpoint carries, so steps 5 and 6 equal the
 uninterrupted run's to 1e-10 too; the same for the steady braked slice (its
-friction entities include the core's angular velocity).
+friction entities include the core's angular velocity), restarted in place and into
+another directory (--output elsewhere: fields.h5 and nip.csv continue the earlier
+run's); nip.csv's rows equal the uninterrupted run's.
 
 Bad restarts exit 1, name the scene file and what does not fit, and leave the
 output directory as it was: another mesh (Mesh/Cells), another step size
@@ -181,8 +183,8 @@ def killed_outputs_readable(tag, out, k):
         T.check(False, f"{tag}: killed run's summary.json readable: {e}")
 
 
-def restart(tag, out, sets, ranks, k, scene=None):
-    args = ["run", scene or SCENE, "--output", out, "--restart", out]
+def restart(tag, out, sets, ranks, k, scene=None, into=None):
+    args = ["run", scene or SCENE, "--output", into or out, "--restart", out]
     for s in sets:
         args += ["--set", s]
     p = T.capstan_run(args, ranks=ranks)
@@ -278,6 +280,18 @@ def compare(tag, ref_out, out, scene=None):
         n = sum(1 for _ in ET.parse(f).getroot().iter("Time"))
     T.check(n == STEPS + 1, f"{tag}: fields.xmf indexes {n} steps ({STEPS + 1})")
 
+    if os.path.exists(os.path.join(ref_out, "nip.csv")):
+        def nip(d):
+            with open(os.path.join(d, "nip.csv")) as f:
+                return list(csv.DictReader(f))
+        na, nb = nip(ref_out), nip(out)
+        same = len(na) == len(nb) and all(
+            x["step"] == y["step"] and x["capstan"] == y["capstan"] and x["state"] == y["state"] and
+            all(close(float(x[k]), float(y[k])) for k in ("s", "z", "pressure", "shear", "slip_rate"))
+            for x, y in zip(na, nb))
+        T.check(same, f"{tag}: nip.csv: {len(nb)} rows of steps {sorted({int(r['step']) for r in nb})}, equal to the "
+                f"uninterrupted run's ({len(na)})")
+
 
 def snapshot(d):
     out = {}
@@ -347,6 +361,12 @@ _, s, out5 = T.run_scene(STEADY, "steady-finished-2", sets=[f"Time/Steps={STEPS}
                          ranks=2)
 restart("steady braked slice, 2 ranks, from a finished run", out5, [f"Time/Steps={STEPS}"], 2, 4, scene=STEADY)
 compare("steady braked slice, 2 ranks, from a finished run", ref5, out5, scene=STEADY)
+# Into another directory: the earlier run's fields.h5 copied there and continued, its
+# nip.csv rows kept (before, the new nip.csv held only the steps after the checkpoint).
+into = T.path("steady-elsewhere")
+restart("steady braked slice, restarted into another directory", out5, [f"Time/Steps={STEPS}"], 2, 4, scene=STEADY,
+        into=into)
+compare("steady braked slice, restarted into another directory", ref5, into, scene=STEADY)
 print(f"    steady slice: {time.time() - t0:.1f} s")
 
 # --- bad restarts ------------------------------------------------------------
