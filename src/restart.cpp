@@ -47,6 +47,7 @@ std::string checkpointBytes(const Model& model, const Timings& timings, const st
   w.put<int>(model.comm->getSize()), w.put<int>(model.comm->getRank());
   w.put<int>(step), w.put<double>(time), w.put<double>(scene.stepSize);
   w.put(scene.mesh.min), w.put(scene.mesh.max), w.put(scene.mesh.cells);
+  w.put(scene.mesh.outerCellRatio), w.put(scene.mesh.fineSector), w.put(std::string(scene.analysis.name()));
   // Displacement of the owned nodes, by node id.
   std::vector<long long> gids(mesh.nodeGids.begin(), mesh.nodeGids.begin() + mesh.numOwnedNodes);
   auto ud = model.u->getData();
@@ -182,7 +183,11 @@ Restart::Restart(const Scene& scene, const Comm& comm, const std::string& dir)
     }
     in_ = std::make_unique<checkpoint::Reader>(std::move(bytes));
     auto& rd = *in_;
-    if (rd.getString() != checkpoint::kMagic) throw std::runtime_error("not a capstan checkpoint");
+    if (const std::string magic = rd.getString(); magic != checkpoint::kMagic)
+      throw std::runtime_error(magic.rfind("capstan checkpoint", 0) == 0
+                                   ? "written by another version of capstan ('" + magic + "'; this one reads '" +
+                                         checkpoint::kMagic + "'): run the scene again"
+                                   : std::string("not a capstan checkpoint"));
     const int ranks = rd.get<int>(), rank = rd.get<int>();
     if (ranks != comm.getSize() || rank != comm.getRank())
       throw std::runtime_error("written by rank " + std::to_string(rank) + " of " + std::to_string(ranks));
@@ -191,6 +196,9 @@ Restart::Restart(const Scene& scene, const Comm& comm, const std::string& dir)
     const double dt = rd.get<double>();
     const auto min = rd.get<std::array<double, 3>>(), max = rd.get<std::array<double, 3>>();
     const auto cells = rd.get<std::array<int, 3>>();
+    const auto ratio = rd.get<double>();
+    const auto sector = rd.get<std::array<double, 3>>();
+    const std::string analysis = rd.getString();
     auto text = [&](const auto& a) {
       return "{" + shortest(a[0]) + ", " + shortest(a[1]) + ", " + shortest(a[2]) + "}";
     };
@@ -198,8 +206,18 @@ Restart::Restart(const Scene& scene, const Comm& comm, const std::string& dir)
       error = "parameter 'Mesh/Cells': the scene has " + text(scene.mesh.cells) + ", the checkpoint's mesh " +
               text(cells) + " (a different mesh size)";
     else if (min != scene.mesh.min || max != scene.mesh.max)
-      error = "parameter 'Mesh/Min', 'Mesh/Max': the scene has " + text(scene.mesh.min) + " to " +
-              text(scene.mesh.max) + ", the checkpoint " + text(min) + " to " + text(max);
+      error = std::string(scene.mesh.type == MeshSpec::Type::Box
+                              ? "parameter 'Mesh/Min', 'Mesh/Max'"
+                              : "parameter 'Mesh/Axis Point', 'Mesh/Inner Radius', 'Mesh/Outer Radius' or 'Mesh/Length'") +
+              ": the scene's mesh spans " + text(scene.mesh.min) + " to " + text(scene.mesh.max) +
+              ", the checkpoint's " + text(min) + " to " + text(max);
+    else if (ratio != scene.mesh.outerCellRatio || sector != scene.mesh.fineSector)
+      error = "parameter 'Mesh/Outer Cell Ratio' or 'Mesh/Fine Sector': the scene has " +
+              shortest(scene.mesh.outerCellRatio) + " and " + text(scene.mesh.fineSector) + ", the checkpoint " +
+              shortest(ratio) + " and " + text(sector) + " (its nodes sit elsewhere)";
+    else if (analysis != scene.analysis.name())
+      error = "parameter 'Analysis/Type': the scene has '" + std::string(scene.analysis.name()) +
+              "', the checkpoint's run '" + analysis + "'";
     else if (dt != scene.stepSize)
       error = "parameter 'Time/Step Size': the scene has " + shortest(scene.stepSize) + ", the checkpoint " +
               shortest(dt);
@@ -261,8 +279,8 @@ void Restart::restore(Model& model, std::vector<StepRecord>& steps, std::vector<
       saved.push_back(std::move(sv));
     }
     if (have != want)
-      throw std::runtime_error("holds the effects [" + have + "], the scene runs [" + want +
-                               "] (a different set of supports, capstans or friction laws)");
+      throw std::runtime_error("parameter 'Supports', 'Capstans' or a capstan's 'Friction/Law': the checkpoint holds "
+                               "the effects [" + have + "], the scene runs [" + want + "]");
     for (size_t i = 0; i < effects.size(); ++i) {
       auto& e = *effects[i];
       const auto& sv = saved[i];
@@ -270,10 +288,11 @@ void Restart::restore(Model& model, std::vector<StepRecord>& steps, std::vector<
       const auto keys = entityKeys(mesh, e, perEntity);
       const size_t entities = perEntity ? keys.size() / perEntity : 0;
       if (perEntity != sv.perEntity || keys.size() != sv.keys.size())
-        throw std::runtime_error(e.name() + ": " + std::to_string(sv.keys.size() / std::max(sv.perEntity, 1)) +
-                                 " entities of " + std::to_string(sv.perEntity) + " nodes, the scene has " +
-                                 std::to_string(entities) + " of " + std::to_string(perEntity) +
-                                 " (another analysis or friction law)");
+        throw std::runtime_error("parameter 'Analysis/Type' or a capstan's 'Friction/Law': the checkpoint's run had "
+                                 "another (its " + e.name() + " has " +
+                                 std::to_string(sv.keys.size() / std::max(sv.perEntity, 1)) + " entities of " +
+                                 std::to_string(sv.perEntity) + " nodes, the scene's " + std::to_string(entities) +
+                                 " of " + std::to_string(perEntity) + ")");
       std::map<std::vector<long long>, size_t> index;
       for (size_t k = 0; k < entities; ++k)
         index[std::vector<long long>(keys.begin() + k * perEntity, keys.begin() + (k + 1) * perEntity)] = k;

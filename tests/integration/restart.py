@@ -28,7 +28,8 @@ another directory (--output elsewhere: fields.h5 and nip.csv continue the earlie
 run's); nip.csv's rows equal the uninterrupted run's.
 
 Bad restarts exit 1, name the scene file and what does not fit, and leave the
-output directory as it was: another mesh (Mesh/Cells), another step size
+output directory as it was: another mesh (Mesh/Cells; the annulus' Outer Cell
+Ratio, its Fine Sector), another analysis (Analysis/Type), another step size
 (Time/Step Size), another rank count, a directory without a checkpoint, a
 damaged checkpoint (one byte flipped: its checksum), an incomplete one (a rank's
 file removed).
@@ -373,6 +374,13 @@ print(f"    steady slice: {time.time() - t0:.1f} s")
 bad_restart("another mesh", out1, ["--set", "Mesh/Cells={40,4,2}"], 1, [SCENE, "Mesh/Cells"])
 bad_restart("another step size", out1, ["--set", "Time/Step Size=0.01"], 1, [SCENE, "Time/Step Size"])
 bad_restart("2-rank checkpoint on 1 rank", out2, ["--set", SMALL[0]], 1, [SCENE, "2 rank(s)"])
+# The steady slice's checkpoint: the same cells graded otherwise, or the other analysis.
+bad_restart("another radial grading", out5, ["--set", f"Time/Steps={STEPS}", "--set", "Mesh/Outer Cell Ratio=0.5"], 2,
+            [STEADY, "Mesh/Outer Cell Ratio"], scene=STEADY)
+bad_restart("another fine sector", out5, ["--set", f"Time/Steps={STEPS}", "--set", "Mesh/Fine Sector={-60, 60, 0.6}"],
+            2, [STEADY, "Mesh/Fine Sector"], scene=STEADY)
+bad_restart("another analysis", out5, ["--set", f"Time/Steps={STEPS}", "--set", "Analysis/Type=Quasi-Static"], 2,
+            [STEADY, "Analysis/Type"], scene=STEADY)
 bad_restart("no checkpoint", ref1, [], 1, [SCENE, "no checkpoint"])
 # A damaged checkpoint (one byte flipped, a copy of the slice's): its checksum says so.
 import shutil  # noqa: E402
