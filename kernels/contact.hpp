@@ -95,6 +95,38 @@ KOKKOS_INLINE_FUNCTION double cylinderGap(const Cylinder& c, const double x[3], 
   return c.R - d;
 }
 
+// How deep the capstan cuts into a face between its contact points: the largest
+// penetration R - d over a 7x7 grid of the bilinear face, its place in `at`, and
+// the face's longest edge (deformed) in `edge`. Contact holds the face's points
+// only; a capstan that the faces have closed behind (the body pushed through it)
+// or that fits between points far apart cuts a face much deeper than the sagitta
+// h^2 / 8R a touching face has.
+KOKKOS_INLINE_FUNCTION double faceCut(const double x[4][3], const Cylinder& c, double at[3], double& edge) {
+  edge = 0;
+  for (int a = 0; a < 4; ++a) {
+    const int b = (a + 1) % 4;
+    const double l = sqrt((x[b][0] - x[a][0]) * (x[b][0] - x[a][0]) + (x[b][1] - x[a][1]) * (x[b][1] - x[a][1]) +
+                          (x[b][2] - x[a][2]) * (x[b][2] - x[a][2]));
+    edge = l > edge ? l : edge;
+  }
+  double deepest = -1e300, e[3], d;
+  for (int k = 0; k < 3; ++k) at[k] = x[0][k];
+  for (int i = 0; i <= 6; ++i)
+    for (int j = 0; j <= 6; ++j) {
+      const double xi = i / 6.0, eta = j / 6.0;
+      const double N[4] = {(1 - xi) * (1 - eta), xi * (1 - eta), xi * eta, (1 - xi) * eta};
+      double p[3] = {0, 0, 0};
+      for (int a = 0; a < 4; ++a)
+        for (int k = 0; k < 3; ++k) p[k] += N[a] * x[a][k];
+      const double g = cylinderGap(c, p, e, d);
+      if (g > deepest) {
+        deepest = g;
+        for (int k = 0; k < 3; ++k) at[k] = p[k];
+      }
+    }
+  return deepest;
+}
+
 // What one contact point reports (for the multiplier update and the outputs).
 struct ContactPoint {
   double gap = 0;        // g = R - d

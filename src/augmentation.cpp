@@ -1,5 +1,6 @@
 #include "augmentation.hpp"
 
+#include "effects/contact.hpp"
 #include "errors.hpp"
 #include "solver_switches.hpp"
 #include "stopwatch.hpp"
@@ -35,6 +36,11 @@ constexpr double kPolishBelow = 10;
 // only to this x r0 where its solves are direct: each stage's last quadratic iteration changes
 // nothing the next stage keeps (docs/steady-rolling.md, "Start from rest").
 constexpr double kGuessTolerance = 1e-7;
+// A capstan cutting a contact face deeper than this fraction of the face's longest edge h, or
+// than half its radius R, between the face's points has passed into the body or fits between
+// the points: a touching face's sagitta h^2 / 8R reaches either only where h > 2R
+// (AugmentationLoop::checkConstraints).
+constexpr double kCutFraction = 0.25;
 // A saddle-point step is halved (to kShortestPressureStep at most) while the residual it leaves
 // exceeds kPressureStepMerit x its starting one: its linear model holds only while no point
 // crosses between stick, slip and free (docs/friction.md, "The multiplier loop in rolling").
@@ -351,7 +357,44 @@ bool AugmentationLoop::checkConstraints(int it, StepRecord& rec, Constraints& c,
       return false;
     }
   }
+  if (c.met) {
+    const std::string through = bodyThroughCapstan();
+    if (!through.empty()) {
+      failure = through;
+      return false;
+    }
+  }
   return true;
+}
+
+// Contact holds the faces' points only: a body pushed through a capstan, the faces closed
+// behind it, balances with every point clear. Such a state is no answer; the step fails. The
+// sweep's slice on a capstan of radius 1 (8x128) converged with it inside the coating and the
+// roller turning backwards (speed ratio -1.06); the drive on 4 cells round converged with the
+// capstan between two nodes.
+std::string AugmentationLoop::bodyThroughCapstan() const {
+  const auto& assembly = *m_.assembly;
+  for (const ContactEffect* contact : assembly.contacts()) {
+    const double tol = contact->constraintTolerance();
+    const ContactEffect::Cut cut = contact->deepestCut(assembly.positions(), *m_.comm);
+    if (cut.depth > std::min(kCutFraction * cut.edge, 0.5 * contact->radius()) && cut.depth > 10 * tol)
+      return format("%s: the capstan (radius %.4g) cuts %.3g into a contact face at (%.4g, %.4g, %.4g), between "
+                    "the face's contact points (its longest edge %.3g): the contact faces there are too coarse to "
+                    "hold the capstan (their edges should be well under its diameter), or the body has passed "
+                    "through it",
+                    contact->name().c_str(), contact->radius(), cut.depth, cut.at[0], cut.at[1], cut.at[2], cut.edge);
+    double points = 0;
+    Teuchos::reduceAll(*m_.comm, Teuchos::REDUCE_MAX, contact->figures({0, 0, 0}).maxPenetration,
+                       Teuchos::outArg(points));
+    const ContactEffect::Cut node = contact->deepestNode(assembly.positions(), *m_.comm);
+    if (node.depth > points + kCutFraction * contact->shortestEdge() + 10 * tol)
+      return format("%s: the body has passed through the capstan (radius %.4g): a node at (%.4g, %.4g, %.4g) lies "
+                    "%.3g inside it while the contact points are clear (%.3g), the body's faces closed behind it; "
+                    "smaller steps, a firmer support of the body, or contact faces fine enough to hold it",
+                    contact->name().c_str(), contact->radius(), node.at[0], node.at[1], node.at[2], node.depth,
+                    points);
+  }
+  return "";
 }
 
 void AugmentationLoop::moveByPressureStep(double t, Vector& f, const Constraints& c, bool stepAlone,

@@ -106,6 +106,8 @@ class AugmentationLoop {
   // Evaluates the constraints at u (converged). False with `failure` set if
   // an effect ran out of augmentations.
   bool checkConstraints(int it, StepRecord& rec, Constraints& c, std::string& failure);
+  // Why a state whose constraints are met is no answer: the body through a capstan (empty: none).
+  std::string bodyThroughCapstan() const;
   // The multipliers' move with the saddle-point step: the plain update for
   // contact and friction, then the step where a constraint with rows is unmet.
   void moveByPressureStep(double t, Vector& f, const Constraints& c, bool stepAlone, PassPolicy& passes,

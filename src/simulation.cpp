@@ -74,10 +74,14 @@ class Simulation {
   void warnOfMeshDependentSettings() const {
     if (!model_->rank0) return;
     const auto& contacts = model_->assembly->contacts();
-    for (size_t i = 0; i < contacts.size(); ++i)
+    for (size_t i = 0; i < contacts.size(); ++i) {
       if (!contacts[i]->quadratureWarning().empty())
         std::fprintf(stderr, "capstan: WARNING: %s: parameter 'Capstans/%s/Contact/Quadrature': %s\n",
                      scene_.file.c_str(), contacts[i]->capstan().name.c_str(), contacts[i]->quadratureWarning().c_str());
+      if (!contacts[i]->coarseFacesWarning().empty())
+        std::fprintf(stderr, "capstan: WARNING: %s: parameter 'Mesh/Cells', 'Capstans/%s/Radius': %s\n",
+                     scene_.file.c_str(), contacts[i]->capstan().name.c_str(), contacts[i]->coarseFacesWarning().c_str());
+    }
   }
 
   // The output directory, the files a restart continues, the initial state.

@@ -167,3 +167,22 @@ TEST(Contact, PointOnTheAxisIsFinite) {
 }
 
 }  // namespace
+
+// faceCut: a flat face whose corners touch the cylinder (axis along z, R = 1, above
+// the face y = 0) is cut by the sagitta R - sqrt(R^2 - (h/2)^2) at its middle; a capstan
+// sunk through the face (axis on it) by R.
+TEST(Contact, FaceCutIsTheSagittaOrTheSunkDepth) {
+  const double h = 0.6;
+  const double a[3] = {0, std::sqrt(1 - h * h / 4), 0}, dir[3] = {0, 0, 1};  // the corners on the surface
+  const Cylinder c = makeCylinder(a, dir, 1.0);
+  double x[4][3] = {{-h / 2, 0, 0}, {h / 2, 0, 0}, {h / 2, 0, 0.2}, {-h / 2, 0, 0.2}};
+  double at[3], edge;
+  const double sagitta = 1 - std::sqrt(1 - h * h / 4);
+  EXPECT_NEAR(faceCut(x, c, at, edge), sagitta, 1e-14);
+  EXPECT_NEAR(at[0], 0, 1e-14);
+  EXPECT_NEAR(edge, h, 1e-14);
+  for (auto& p : x) p[1] += a[1];  // the face through the axis
+  EXPECT_NEAR(faceCut(x, c, at, edge), 1.0, 1e-14);
+  for (auto& p : x) p[1] -= 3;  // well clear: a negative cut, the face's distance from the surface
+  EXPECT_NEAR(faceCut(x, c, at, edge), -2.0, 1e-14);
+}

@@ -47,6 +47,33 @@ ContactEffect::ContactEffect(const std::string& name, const Mesh& mesh, const st
   double hMin = h;
   Teuchos::reduceAll(*mesh.comm, Teuchos::REDUCE_MIN, h, Teuchos::outArg(hMin));
   shortestEdge_ = hMin;
+  // Faces near the capstan at the start (a node within 3R of its axis) longer than its
+  // diameter: contact holds their points only, and the capstan can sit between them.
+  double hNear = 0;
+  for (size_t f = 0; f < nf; ++f) {
+    bool near = false;
+    double longest = 0;
+    for (int a = 0; a < 4; ++a) {
+      const int n0 = quads[4 * f + a], n1 = quads[4 * f + (a + 1) % 4];
+      std::array<double, 3> r{}, e{};
+      double l2 = 0;
+      for (int i = 0; i < 3; ++i) {
+        l2 += std::pow(mesh.X[3 * n1 + i] - mesh.X[3 * n0 + i], 2);
+        r[i] = mesh.X[3 * n0 + i] - capstan.axisPoint[i];
+      }
+      e = sub(r, scale(beta_, dot(r, beta_)));
+      near = near || norm(e) < 3 * capstan.radius;
+      longest = std::max(longest, std::sqrt(l2));
+    }
+    if (near) hNear = std::max(hNear, longest);
+  }
+  double hNearAll = 0;
+  Teuchos::reduceAll(*mesh.comm, Teuchos::REDUCE_MAX, hNear, Teuchos::outArg(hNearAll));
+  if (hNearAll > 2 * capstan.radius)
+    coarseFacesWarning_ = format("contact faces near the capstan are up to %.3g long, more than its diameter %.3g: "
+                                 "contact holds the faces' points only, and the capstan can sit between them (a "
+                                 "finer Mesh/Cells there)",
+                                 hNearAll, 2 * capstan.radius);
   tolerance_ = settings.penetrationTolerance > 0 ? settings.penetrationTolerance : 1e-4 * hMin;
   capstan_.contact.quadrature = settings.resolvedQuadrature(hMin, c, exactStick);
   // A Gauss rule the scene names where Auto would take the nodal one.
@@ -129,6 +156,78 @@ void ContactEffect::launch(const NodalVectors& x, const NodalVectors&, bool tang
           }
         }
       });
+}
+
+ContactEffect::Cut ContactEffect::deepestCut(const NodalVectors& x, const Teuchos::Comm<int>& comm) const {
+  auto nodes = nodes_;
+  const kernels::Cylinder cyl = cylinder();
+  using MaxLoc = Kokkos::MaxLoc<double, int>;
+  typename MaxLoc::value_type local;
+  Kokkos::parallel_reduce(
+      "contact deepest cut", Kokkos::RangePolicy<ExecSpace>(0, nodes.extent(0)),
+      KOKKOS_LAMBDA(int f, typename MaxLoc::value_type& m) {
+        double xf[4][3], at[3], edge;
+        for (int a = 0; a < 4; ++a)
+          for (int i = 0; i < 3; ++i) xf[a][i] = x(nodes(f, a), i);
+        const double depth = kernels::faceCut(xf, cyl, at, edge);
+        const double ratio = depth > 0 && edge > 0 ? depth / edge : 0.0;
+        if (ratio > m.val) m.val = ratio, m.loc = f;
+      },
+      MaxLoc(local));
+  const bool any = nodes.extent(0) > 0 && local.val > 0;
+  const double mine = any ? local.val : 0.0;
+  double worst = 0;
+  Teuchos::reduceAll(comm, Teuchos::REDUCE_MAX, mine, Teuchos::outArg(worst));
+  Cut cut;
+  if (!(worst > 0)) return cut;
+  // The details from the lowest rank that holds the worst face.
+  const int holder = any && mine == worst ? comm.getRank() : comm.getSize();
+  int first = holder;
+  Teuchos::reduceAll(comm, Teuchos::REDUCE_MIN, holder, Teuchos::outArg(first));
+  double mineDetails[5] = {0, 0, 0, 0, 0}, details[5];
+  if (first == comm.getRank()) {
+    auto xh = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), x);
+    auto nh = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), nodes);
+    double xf[4][3], at[3], edge;
+    for (int a = 0; a < 4; ++a)
+      for (int i = 0; i < 3; ++i) xf[a][i] = xh(nh(local.loc, a), i);
+    mineDetails[0] = kernels::faceCut(xf, cyl, at, edge);
+    mineDetails[1] = edge;
+    for (int i = 0; i < 3; ++i) mineDetails[2 + i] = at[i];
+  }
+  Teuchos::reduceAll(comm, Teuchos::REDUCE_SUM, 5, mineDetails, details);
+  cut.depth = details[0], cut.edge = details[1];
+  for (int i = 0; i < 3; ++i) cut.at[i] = details[2 + i];
+  return cut;
+}
+
+ContactEffect::Cut ContactEffect::deepestNode(const NodalVectors& x, const Teuchos::Comm<int>& comm) const {
+  const kernels::Cylinder cyl = cylinder();
+  using MaxLoc = Kokkos::MaxLoc<double, int>;
+  typename MaxLoc::value_type local;
+  Kokkos::parallel_reduce(
+      "contact deepest node", Kokkos::RangePolicy<ExecSpace>(0, x.extent(0)),
+      KOKKOS_LAMBDA(int n, typename MaxLoc::value_type& m) {
+        const double p[3] = {x(n, 0), x(n, 1), x(n, 2)};
+        double e[3], d;
+        const double g = kernels::cylinderGap(cyl, p, e, d);
+        if (g > m.val) m.val = g, m.loc = n;
+      },
+      MaxLoc(local));
+  const bool any = x.extent(0) > 0;
+  const double mine = any ? local.val : -1e300;
+  Cut cut;
+  Teuchos::reduceAll(comm, Teuchos::REDUCE_MAX, mine, Teuchos::outArg(cut.depth));
+  const int holder = any && mine == cut.depth ? comm.getRank() : comm.getSize();
+  int first = holder;
+  Teuchos::reduceAll(comm, Teuchos::REDUCE_MIN, holder, Teuchos::outArg(first));
+  double at[3] = {0, 0, 0};
+  if (first == comm.getRank()) {
+    auto xh = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), x);
+    for (int i = 0; i < 3; ++i) at[i] = xh(local.loc, i);
+  }
+  Teuchos::reduceAll(comm, Teuchos::REDUCE_SUM, 3, at, cut.at.data());
+  return cut;
 }
 
 // Uzawa: lambda <- t_n (= max(0, lambda + (g - kappa lambda) / eps)).

@@ -29,6 +29,8 @@ class ContactEffect : public Effect {
   // A Gauss rule the scene names with a Penalty that Auto would give the nodal
   // rule: what the run warns of (empty otherwise).
   const std::string& quadratureWarning() const { return quadratureWarning_; }
+  // Faces near the capstan longer than its diameter: what the run warns of (empty otherwise).
+  const std::string& coarseFacesWarning() const { return coarseFacesWarning_; }
   Kokkos::View<double*> multipliers() override {
     return augmented() ? lambda_ : Kokkos::View<double*>();
   }
@@ -68,6 +70,18 @@ class ContactEffect : public Effect {
                   std::vector<double>& traction) const;
   const std::array<double, 3>& axisDirection() const { return beta_; }
   double radius() const { return capstan_.radius; }
+  // The face the capstan cuts deepest between its contact points, relative to the face's
+  // longest edge (collective; kernels::faceCut): a quarter of an edge or more means the body
+  // has passed through the capstan, or the faces are too coarse to hold it.
+  struct Cut {
+    double depth = 0, edge = 0;
+    std::array<double, 3> at{};
+  };
+  Cut deepestCut(const NodalVectors& x, const Teuchos::Comm<int>& comm) const;
+  // The body's node (any node, x: all of this rank's) deepest inside the capstan (collective;
+  // `edge` unused): beyond the contact points' own penetration only where the capstan is
+  // inside the body, which its faces closed behind.
+  Cut deepestNode(const NodalVectors& x, const Teuchos::Comm<int>& comm) const;
   // The shortest candidate face edge over all ranks (the mesh's scale at the contact).
   double shortestEdge() const { return shortestEdge_; }
   // Predictor: the contact tangent without its geometric stiffness (see
@@ -102,6 +116,7 @@ class ContactEffect : public Effect {
   std::array<double, 3> beta_{};  // unit axis direction
   double time_ = 0;
   std::string quadratureWarning_;
+  std::string coarseFacesWarning_;
   bool predicting_ = false;
   double solvePenalty_ = 1e-3;  // eps of the Newton solves
   double compliance_ = 1e-3;    // kappa: g = kappa t_n at the fixed point (0: exact contact)

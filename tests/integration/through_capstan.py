@@ -1,0 +1,66 @@
+#!/usr/bin/env python3
+"""A state with the body through a capstan is no answer (AugmentationLoop::bodyThroughCapstan).
+
+Contact holds the contact faces' points only. A body pushed through a capstan, its faces
+closed behind it, balances with every point clear; so does a capstan that fits between
+the points of faces much longer than its diameter. Both converged before with exit 0:
+
+  * the steady slice (inputs/pinch-roller-slice-steady.xml) on 8x128 cells with a capstan
+    of radius 1 just touching it (Axis Point y = -7.2455): the frictionless footprint's
+    pseudo-time carried the roller 12.6 down, through the capstan, and the run reported
+    a speed ratio of -1.064 with max_penetration 0. Now that try fails ("passed through
+    the capstan", a node 0.85 inside it), the step is cut, and the run converges to the
+    physical state: the core's translation below 0.5 (0.066 today; it was 12.6) and the speed ratio within 1e-3 of
+    the same capstan on the shipped 4x64 mesh (0.988);
+  * the 3D drive (inputs/pinch-roller-steady.xml) on 4 cells round: faces 12.3 long
+    against the capstan's diameter of 5, the capstan sat 1.75 deep between two nodes and
+    the speed ratio was -0.67. Now such a try fails ("cuts ... into a contact face") and
+    the run converges with the capstan on the outside (speed ratio 0.9-1.1). The run warns
+    of contact faces near the capstan longer than its diameter.
+
+Every shipped scene takes the same Newton iterations with the check (docs/contact.md).
+"""
+import os
+import sys
+
+sys.dont_write_bytecode = True
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from capstan_test import Test, has_nan  # noqa: E402
+
+T = Test("through_capstan", __doc__)
+SLICE = T.input("pinch-roller-slice-steady.xml")
+SMALL = ["Capstans/capstan/Radius=0.9955", "Capstans/capstan/Axis Point={0, -7.2455, 0}"]
+
+
+def core(s):
+    c = s["steps"][-1]["supports"]["core"]
+    return c["speed_ratio"], c["translation"]
+
+
+p, fine, out = T.run_scene(SLICE, "small-capstan-8x128", sets=SMALL + ["Mesh/Cells={8, 128, 1}"], quiet=False)
+_, coarse, _ = T.run_scene(SLICE, "small-capstan-4x64", sets=SMALL)
+if fine is not None and coarse is not None and fine["converged"] and coarse["converged"]:
+    T.conforms(out, SLICE)
+    T.check(not has_nan(fine), "small capstan: no NaN in summary.json")
+    T.check("has passed through the capstan" in p.stdout,
+            "small capstan: a try through the capstan failed, said on the progress lines")
+    (ratio, t), (ratio_ref, _) = core(fine), core(coarse)
+    T.check(abs(t[1]) < 0.5, f"small capstan: the core's translation {t[1]:.4g} (|.| < 0.5, a quarter of the coating: "
+            f"not through it; 4x64: {core(coarse)[1][1]:.4g})")
+    T.check(abs(ratio - ratio_ref) < 1e-3,
+            f"small capstan: speed ratio {ratio:.6f} against 4x64's {ratio_ref:.6f} (within 1e-3)")
+else:
+    T.check(False, "small capstan: both meshes converged")
+
+DRIVE = T.input("pinch-roller-steady.xml")
+p, four, out = T.run_scene(DRIVE, "four-cells-round", sets=["Mesh/Cells={5, 4, 8}", "Output/Write Fields=false"],
+                           quiet=False)
+if four is not None and four["converged"]:
+    ratio, t = core(four)
+    T.check("into a contact face" in p.stdout, "four cells round: a try with the capstan between nodes failed, said")
+    T.check("contact faces near the capstan are up to 12.3 long" in p.stderr,
+            "four cells round: warned of faces longer than the capstan's diameter")
+    T.check(0.9 < ratio < 1.1, f"four cells round: speed ratio {ratio:.4f} (0.9-1.1: the capstan outside)")
+else:
+    T.check(False, "four cells round: converged")
+T.finish()
