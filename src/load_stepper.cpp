@@ -21,14 +21,20 @@ constexpr double kPseudoTimeWithStickSubstep = 1.0 / 8;
 // (docs/numerics.md, "Load steps").
 constexpr int kMostCutsPerStep = 40;
 
-// How long after t the cores' external loads (forces, torques) still ramp: 0
-// once all are in.
+// How long after t the first of the cores' external loads (forces, torques) still ramping is
+// in: 0 once all are. A cut halves that span, so the load that comes in first eases first: with
+// a brake ramped over the whole step and the force over 1e-6, cuts within the brake's ramp left
+// the force whole, and a footprint that needed a lighter one failed through every cut (the
+// sweep's slice on a capstan of radius 1: exit 2; without the brake's ramp it converged).
 double loadRampLeft(const Assembly& assembly, double t) {
   double left = 0;
+  auto first = [&](double rampTime) {
+    if (rampTime > t && (left == 0 || rampTime - t < left)) left = rampTime - t;
+  };
   for (const auto& core : assembly.rigidCores()) {
     const bool force = core.force[0] != 0 || core.force[1] != 0 || core.force[2] != 0;
-    if (force && core.rampTime > t) left = std::max(left, core.rampTime - t);
-    if (core.torque != 0 && core.torqueRampTime > t) left = std::max(left, core.torqueRampTime - t);
+    if (force) first(core.rampTime);
+    if (core.torque != 0) first(core.torqueRampTime);
   }
   return left;
 }

@@ -14,7 +14,10 @@ ramped to 18 N mm (90% of mu F R) over 10 steps, as scripts/steady-bench.py runs
     to the step's), none for the continuation steps;
   * the saddle-point step was shortened at least once (the merit test that keeps a step
     from pushing points across stick, slip and free: src/augmentation.cpp), and every
-    shortening was called for (the longer step left |R| above the step's start).
+    shortening was called for (the longer step left |R| above the step's start);
+  * a braked slice on a capstan of radius 1 whose first step needs the force eased: a cut
+    halves the span to the first load still ramping (the force), so it converges, at the
+    speed ratio of the same brake put on at once (2e-5), the ratios falling step by step.
 """
 import os
 import sys
@@ -63,4 +66,26 @@ if s:
     T.check(all(e["residual"] > e["start"] for e in halved), "each shortening: the longer step left |R| above the start")
 else:
     T.check(False, "the sweep converges")
+
+# A footprint that needs the force eased: the braked slice on a capstan of radius 1 just
+# touching it, the brake ramped over the sweep's 4 steps. Its first step fails at the full
+# force; a cut halves the span to the first load still ramping (the force's 1e-6), so the
+# force eases. Before, cuts halved the brake's ramp, left the force whole, and the run
+# ended in exit 2; without the brake's ramp the same first step converged.
+SMALL = ["Capstans/capstan/Radius=0.9955", "Capstans/capstan/Axis Point={0, -7.2455, 0}"]
+braked = T.input("pinch-roller-braked-steady.xml")
+_, b, _ = T.run_scene(braked, "small-capstan-sweep", sets=SMALL + [
+    "Supports/core/Torque=0.4", "Supports/core/Torque Ramp Time=0.004", "Time/Steps=4", "Output/Write Fields=false"])
+_, one, _ = T.run_scene(braked, "small-capstan-unramped", sets=SMALL + [
+    "Supports/core/Torque=0.1", "Supports/core/Torque Ramp Time=1e-6", "Time/Steps=1", "Output/Write Fields=false"])
+if b is not None and b["converged"] and one is not None and one["converged"]:
+    ratios = [st["supports"]["core"]["speed_ratio"] for st in b["steps"]]
+    T.check(b["steps"][0]["cutbacks"] > 0 and all(st["cutbacks"] == 0 for st in b["steps"][1:]),
+            f"small capstan sweep: its first step cut, the others not ({[st['cutbacks'] for st in b['steps']]})")
+    T.check(all(r1 < r0 for r0, r1 in zip(ratios, ratios[1:])), f"small capstan sweep: speed ratios fall {ratios}")
+    r_one = one["steps"][0]["supports"]["core"]["speed_ratio"]
+    T.check(abs(ratios[0] - r_one) < 2e-5,
+            f"small capstan sweep: first step {ratios[0]:.6f} against the unramped brake's {r_one:.6f} (2e-5)")
+else:
+    T.check(False, "small capstan sweep and its unramped first step converged")
 T.finish()
