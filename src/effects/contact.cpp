@@ -158,6 +158,22 @@ void ContactEffect::launch(const NodalVectors& x, const NodalVectors&, bool tang
       });
 }
 
+namespace {
+
+// The worst entity's details, from the lowest rank that holds it (collective).
+template <size_t N, class Details>
+std::array<double, N> fromLowestHolder(const Teuchos::Comm<int>& comm, bool holds, Details details) {
+  const int holder = holds ? comm.getRank() : comm.getSize();
+  int first = holder;
+  Teuchos::reduceAll(comm, Teuchos::REDUCE_MIN, holder, Teuchos::outArg(first));
+  std::array<double, N> mine{}, all{};
+  if (first == comm.getRank()) mine = details();
+  Teuchos::reduceAll(comm, Teuchos::REDUCE_SUM, int(N), mine.data(), all.data());
+  return all;
+}
+
+}  // namespace
+
 ContactEffect::Cut ContactEffect::deepestCut(const NodalVectors& x, const Teuchos::Comm<int>& comm) const {
   auto nodes = nodes_;
   const kernels::Cylinder cyl = cylinder();
@@ -174,30 +190,21 @@ ContactEffect::Cut ContactEffect::deepestCut(const NodalVectors& x, const Teucho
         if (ratio > m.val) m.val = ratio, m.loc = f;
       },
       MaxLoc(local));
-  const bool any = nodes.extent(0) > 0 && local.val > 0;
-  const double mine = any ? local.val : 0.0;
+  const double mine = nodes.extent(0) > 0 && local.val > 0 ? local.val : 0.0;
   double worst = 0;
   Teuchos::reduceAll(comm, Teuchos::REDUCE_MAX, mine, Teuchos::outArg(worst));
   Cut cut;
   if (!(worst > 0)) return cut;
-  // The details from the lowest rank that holds the worst face.
-  const int holder = any && mine == worst ? comm.getRank() : comm.getSize();
-  int first = holder;
-  Teuchos::reduceAll(comm, Teuchos::REDUCE_MIN, holder, Teuchos::outArg(first));
-  double mineDetails[5] = {0, 0, 0, 0, 0}, details[5];
-  if (first == comm.getRank()) {
+  const auto d = fromLowestHolder<5>(comm, mine == worst, [&] {
     auto xh = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), x);
     auto nh = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), nodes);
     double xf[4][3], at[3], edge;
     for (int a = 0; a < 4; ++a)
       for (int i = 0; i < 3; ++i) xf[a][i] = xh(nh(local.loc, a), i);
-    mineDetails[0] = kernels::faceCut(xf, cyl, at, edge);
-    mineDetails[1] = edge;
-    for (int i = 0; i < 3; ++i) mineDetails[2 + i] = at[i];
-  }
-  Teuchos::reduceAll(comm, Teuchos::REDUCE_SUM, 5, mineDetails, details);
-  cut.depth = details[0], cut.edge = details[1];
-  for (int i = 0; i < 3; ++i) cut.at[i] = details[2 + i];
+    const double depth = kernels::faceCut(xf, cyl, at, edge);
+    return std::array<double, 5>{depth, edge, at[0], at[1], at[2]};
+  });
+  cut.depth = d[0], cut.edge = d[1], cut.at = {d[2], d[3], d[4]};
   return cut;
 }
 
@@ -214,19 +221,13 @@ ContactEffect::Cut ContactEffect::deepestNode(const NodalVectors& x, const Teuch
         if (g > m.val) m.val = g, m.loc = n;
       },
       MaxLoc(local));
-  const bool any = x.extent(0) > 0;
-  const double mine = any ? local.val : -1e300;
+  const double mine = x.extent(0) > 0 ? local.val : -1e300;
   Cut cut;
   Teuchos::reduceAll(comm, Teuchos::REDUCE_MAX, mine, Teuchos::outArg(cut.depth));
-  const int holder = any && mine == cut.depth ? comm.getRank() : comm.getSize();
-  int first = holder;
-  Teuchos::reduceAll(comm, Teuchos::REDUCE_MIN, holder, Teuchos::outArg(first));
-  double at[3] = {0, 0, 0};
-  if (first == comm.getRank()) {
+  cut.at = fromLowestHolder<3>(comm, x.extent(0) > 0 && mine == cut.depth, [&] {
     auto xh = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), x);
-    for (int i = 0; i < 3; ++i) at[i] = xh(local.loc, i);
-  }
-  Teuchos::reduceAll(comm, Teuchos::REDUCE_SUM, 3, at, cut.at.data());
+    return std::array<double, 3>{xh(local.loc, 0), xh(local.loc, 1), xh(local.loc, 2)};
+  });
   return cut;
 }
 
