@@ -376,16 +376,18 @@ std::string AugmentationLoop::bodyThroughCapstan() const {
   const auto& assembly = *m_.assembly;
   for (const ContactEffect* contact : assembly.contacts()) {
     const double tol = contact->constraintTolerance();
-    const ContactEffect::Cut cut = contact->deepestCut(assembly.positions(), *m_.comm);
-    if (cut.depth > std::min(kCutFraction * cut.edge, 0.5 * contact->radius()) && cut.depth > 10 * tol)
-      return format("%s: the capstan (radius %.4g) cuts %.3g into a contact face at (%.4g, %.4g, %.4g), between "
-                    "the face's contact points (its longest edge %.3g): the contact faces there are too coarse to "
-                    "hold the capstan (their edges should be well under its diameter), or the body has passed "
-                    "through it",
-                    contact->name().c_str(), contact->radius(), cut.depth, cut.at[0], cut.at[1], cut.at[2], cut.edge);
+    // The contact points' own penetration (a soft penalty's is the model's) comes first.
     double points = 0;
     Teuchos::reduceAll(*m_.comm, Teuchos::REDUCE_MAX, contact->figures({0, 0, 0}).maxPenetration,
                        Teuchos::outArg(points));
+    const ContactEffect::Cut cut = contact->deepestCut(assembly.positions(), *m_.comm);
+    if (cut.depth > points + std::min(kCutFraction * cut.edge, 0.5 * contact->radius()) && cut.depth > 10 * tol)
+      return format("%s: the capstan (radius %.4g) cuts %.3g into a contact face at (%.4g, %.4g, %.4g), between "
+                    "the face's contact points (its longest edge %.3g; the points %.3g): the contact faces there "
+                    "are too coarse to hold the capstan (their edges should be well under its diameter), or the "
+                    "body has passed through it",
+                    contact->name().c_str(), contact->radius(), cut.depth, cut.at[0], cut.at[1], cut.at[2], cut.edge,
+                    points);
     const ContactEffect::Cut node = contact->deepestNode(assembly.positions(), *m_.comm);
     if (node.depth > points + kCutFraction * contact->shortestEdge() + 10 * tol)
       return format("%s: the body has passed through the capstan (radius %.4g): a node at (%.4g, %.4g, %.4g) lies "
