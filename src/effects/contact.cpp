@@ -35,40 +35,31 @@ ContactEffect::ContactEffect(const std::string& name, const Mesh& mesh, const st
   local_.R = Matrix("contact R", nf, 12);
   local_.stiff = true;
   local_.active = Kokkos::View<int*>("contact active", nf);
-  // The smallest candidate face edge over all ranks sets the defaults.
-  double h = 1e300;
-  for (size_t f = 0; f < nf; ++f)
-    for (int a = 0; a < 4; ++a) {
-      const int n0 = quads[4 * f + a], n1 = quads[4 * f + (a + 1) % 4];
-      double l2 = 0;
-      for (int i = 0; i < 3; ++i) l2 += std::pow(mesh.X[3 * n1 + i] - mesh.X[3 * n0 + i], 2);
-      h = std::min(h, std::sqrt(l2));
-    }
-  double hMin = h;
-  Teuchos::reduceAll(*mesh.comm, Teuchos::REDUCE_MIN, h, Teuchos::outArg(hMin));
-  shortestEdge_ = hMin;
-  // Faces near the capstan at the start (a node within 3R of its axis) longer than its
-  // diameter: contact holds their points only, and the capstan can sit between them.
-  double hNear = 0;
+  // The shortest candidate face edge over all ranks sets the defaults. The longest edge of
+  // the faces near the capstan at the start (a node within 3R of its axis) is warned of where
+  // it exceeds the capstan's diameter: contact holds the points only, and the capstan can sit
+  // between them.
+  double h = 1e300, hNear = 0;
   for (size_t f = 0; f < nf; ++f) {
     bool near = false;
     double longest = 0;
     for (int a = 0; a < 4; ++a) {
       const int n0 = quads[4 * f + a], n1 = quads[4 * f + (a + 1) % 4];
-      std::array<double, 3> r{}, e{};
-      double l2 = 0;
+      Vec3 edge{}, r{};
       for (int i = 0; i < 3; ++i) {
-        l2 += std::pow(mesh.X[3 * n1 + i] - mesh.X[3 * n0 + i], 2);
+        edge[i] = mesh.X[3 * n1 + i] - mesh.X[3 * n0 + i];
         r[i] = mesh.X[3 * n0 + i] - capstan.axisPoint[i];
       }
-      e = sub(r, scale(beta_, dot(r, beta_)));
-      near = near || norm(e) < 3 * capstan.radius;
-      longest = std::max(longest, std::sqrt(l2));
+      h = std::min(h, norm(edge));
+      longest = std::max(longest, norm(edge));
+      near = near || norm(sub(r, scale(beta_, dot(r, beta_)))) < 3 * capstan.radius;
     }
     if (near) hNear = std::max(hNear, longest);
   }
-  double hNearAll = 0;
+  double hMin = h, hNearAll = 0;
+  Teuchos::reduceAll(*mesh.comm, Teuchos::REDUCE_MIN, h, Teuchos::outArg(hMin));
   Teuchos::reduceAll(*mesh.comm, Teuchos::REDUCE_MAX, hNear, Teuchos::outArg(hNearAll));
+  shortestEdge_ = hMin;
   if (hNearAll > 2 * capstan.radius)
     coarseFacesWarning_ = format("contact faces near the capstan are up to %.3g long, more than its diameter %.3g: "
                                  "contact holds the faces' points only, and the capstan can sit between them (a "
