@@ -36,10 +36,11 @@ constexpr double kPolishBelow = 10;
 // only to this x r0 where its solves are direct: each stage's last quadratic iteration changes
 // nothing the next stage keeps (docs/steady-rolling.md, "Start from rest").
 constexpr double kGuessTolerance = 1e-7;
-// A capstan cutting a contact face deeper than this fraction of the face's longest edge h, or
-// than half its radius R, between the face's points has passed into the body or fits between
-// the points: a touching face's sagitta h^2 / 8R reaches either only where h > 2R
-// (AugmentationLoop::checkConstraints).
+// A capstan cutting a contact face deeper than the contact points' own penetration plus this
+// fraction of the face's longest edge h (or half its radius R), between the face's points, has
+// passed into the body or fits between the points: a touching face's sagitta h^2 / 8R reaches
+// either only where h > 2R. A body node that deep beyond the points (by this fraction of the
+// shortest edge) is inside it (AugmentationLoop::bodyThroughCapstan).
 constexpr double kCutFraction = 0.25;
 // A saddle-point step is halved (to kShortestPressureStep at most) while the residual it leaves
 // exceeds kPressureStepMerit x its starting one: its linear model holds only while no point

@@ -163,24 +163,33 @@ std::array<double, N> fromLowestHolder(const Teuchos::Comm<int>& comm, bool hold
   return all;
 }
 
+// The largest value(i) over i < n and where (a Kokkos loop: value is a device function).
+template <class Value>
+Kokkos::MaxLoc<double, int>::value_type largestOf(const char* label, size_t n, Value value) {
+  using MaxLoc = Kokkos::MaxLoc<double, int>;
+  typename MaxLoc::value_type best;
+  Kokkos::parallel_reduce(
+      label, Kokkos::RangePolicy<ExecSpace>(0, n),
+      KOKKOS_LAMBDA(int i, typename MaxLoc::value_type& m) {
+        const double v = value(i);
+        if (v > m.val) m.val = v, m.loc = i;
+      },
+      MaxLoc(best));
+  return best;
+}
+
 }  // namespace
 
 ContactEffect::Cut ContactEffect::deepestCut(const NodalVectors& x, const Teuchos::Comm<int>& comm) const {
   auto nodes = nodes_;
   const kernels::Cylinder cyl = cylinder();
-  using MaxLoc = Kokkos::MaxLoc<double, int>;
-  typename MaxLoc::value_type local;
-  Kokkos::parallel_reduce(
-      "contact deepest cut", Kokkos::RangePolicy<ExecSpace>(0, nodes.extent(0)),
-      KOKKOS_LAMBDA(int f, typename MaxLoc::value_type& m) {
-        double xf[4][3], at[3], edge;
-        for (int a = 0; a < 4; ++a)
-          for (int i = 0; i < 3; ++i) xf[a][i] = x(nodes(f, a), i);
-        const double depth = kernels::faceCut(xf, cyl, at, edge);
-        const double ratio = depth > 0 && edge > 0 ? depth / edge : 0.0;
-        if (ratio > m.val) m.val = ratio, m.loc = f;
-      },
-      MaxLoc(local));
+  const auto local = largestOf("contact deepest cut", nodes.extent(0), KOKKOS_LAMBDA(int f) {
+    double xf[4][3], at[3], edge;
+    for (int a = 0; a < 4; ++a)
+      for (int i = 0; i < 3; ++i) xf[a][i] = x(nodes(f, a), i);
+    const double depth = kernels::faceCut(xf, cyl, at, edge);
+    return depth > 0 && edge > 0 ? depth / edge : 0.0;
+  });
   const double mine = nodes.extent(0) > 0 && local.val > 0 ? local.val : 0.0;
   double worst = 0;
   Teuchos::reduceAll(comm, Teuchos::REDUCE_MAX, mine, Teuchos::outArg(worst));
@@ -201,17 +210,11 @@ ContactEffect::Cut ContactEffect::deepestCut(const NodalVectors& x, const Teucho
 
 ContactEffect::Cut ContactEffect::deepestNode(const NodalVectors& x, const Teuchos::Comm<int>& comm) const {
   const kernels::Cylinder cyl = cylinder();
-  using MaxLoc = Kokkos::MaxLoc<double, int>;
-  typename MaxLoc::value_type local;
-  Kokkos::parallel_reduce(
-      "contact deepest node", Kokkos::RangePolicy<ExecSpace>(0, x.extent(0)),
-      KOKKOS_LAMBDA(int n, typename MaxLoc::value_type& m) {
-        const double p[3] = {x(n, 0), x(n, 1), x(n, 2)};
-        double e[3], d;
-        const double g = kernels::cylinderGap(cyl, p, e, d);
-        if (g > m.val) m.val = g, m.loc = n;
-      },
-      MaxLoc(local));
+  const auto local = largestOf("contact deepest node", x.extent(0), KOKKOS_LAMBDA(int n) {
+    const double p[3] = {x(n, 0), x(n, 1), x(n, 2)};
+    double e[3], d;
+    return kernels::cylinderGap(cyl, p, e, d);
+  });
   const double mine = x.extent(0) > 0 ? local.val : -1e300;
   Cut cut;
   Teuchos::reduceAll(comm, Teuchos::REDUCE_MAX, mine, Teuchos::outArg(cut.depth));
