@@ -72,7 +72,7 @@ void Model::buildPressureStep() {
       *assembly, laplacian ? PressureStep::Schur::Laplacian : PressureStep::Schur::Diagonal, preconditioner);
   monolithic = scene.solver.monolithic && !(scene.solver.monolithicIfExact && newton->iterative());
   if (monolithic && scene.solver.minimumSolvePenaltyAutomatic)
-    assembly->bricks().setSolvePenalty(std::max(scene.pressurePenalty, S::kMonolithicSolvePenalty / scene.c));
+    assembly->bricks().setSolvePenalty(S::solvePenalty(scene.pressurePenalty, S::kMonolithicSolvePenalty, scene.c));
 }
 
 double Model::linearSolveSeconds() const {

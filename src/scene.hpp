@@ -53,7 +53,7 @@ struct Scene {
   std::string file, title;
   AnalysisSettings analysis;       // Quasi-Static or Steady Rolling
   MeshSpec mesh;
-  double c = 1, pressurePenalty = 1e-3;
+  double c = 1, pressurePenalty = 0;  // pressurePenalty 0: automatic (SolverSettings::solvePenalty)
   std::array<double, 3> bodyForce{};  // Loads/Body Force at the end of the run
   std::vector<SupportSpec> supports;
   std::vector<CapstanSpec> capstans;

@@ -78,6 +78,9 @@ class Simulation {
       if (!contacts[i]->quadratureWarning().empty())
         std::fprintf(stderr, "capstan: WARNING: %s: parameter 'Capstans/%s/Contact/Quadrature': %s\n",
                      scene_.file.c_str(), contacts[i]->capstan().name.c_str(), contacts[i]->quadratureWarning().c_str());
+      if (!contacts[i]->softPenaltyWarning().empty())
+        std::fprintf(stderr, "capstan: WARNING: %s: parameter 'Capstans/%s/Contact/Penalty': %s\n",
+                     scene_.file.c_str(), contacts[i]->capstan().name.c_str(), contacts[i]->softPenaltyWarning().c_str());
       if (!contacts[i]->coarseFacesWarning().empty())
         std::fprintf(stderr, "capstan: WARNING: %s: parameter 'Mesh/Cells', 'Capstans/%s/Radius': %s\n",
                      scene_.file.c_str(), contacts[i]->capstan().name.c_str(), contacts[i]->coarseFacesWarning().c_str());

@@ -77,7 +77,7 @@ ContactEffect::ContactEffect(const std::string& name, const Mesh& mesh, const st
       quadratureWarning_ = format("Gauss %s with Penalty %g, below %g h / c = %g (h = %g, the shortest contact face "
                                   "edge): Gauss points of flat faces lock against the curved capstan and the loops "
                                   "stall (docs/contact.md, \"Stiff penalties\"); Auto gives this penalty Nodal",
-                                  gauss, settings.penalty, ContactSettings::kGaussPenaltyLimit,
+                                  gauss, settings.resolvedPenalty(hMin, c), ContactSettings::kGaussPenaltyLimit,
                                   ContactSettings::kGaussPenaltyLimit * hMin / c, hMin);
     else if (exactStick)
       quadratureWarning_ = format("Gauss %s under Coulomb in steady rolling: its exact stick has rows in the "
@@ -93,8 +93,23 @@ ContactEffect::ContactEffect(const std::string& name, const Mesh& mesh, const st
   const double floor = settings.minimumSolvePenalty >= 0 ? settings.minimumSolvePenalty
                        : nodal                           ? 1e-2 * hMin / c
                                                          : 0.0;
-  solvePenalty_ = std::max(settings.penalty, floor);
-  compliance_ = settings.exact() ? 0.0 : settings.penalty;
+  // The augmented Lagrangian's answer does not depend on eps2: a softer solve than
+  // kSoftestExactSolve h / c is stiffened to it (a scene in metres and pascals with a penalty
+  // meant for millimetres and megapascals stalled: docs/contact.md, "Penalties in any units").
+  const double penalty = settings.resolvedPenalty(hMin, c);
+  const double softest = ContactSettings::kSoftestExactSolve * hMin / c;
+  double solve = settings.exact() ? std::min(penalty, softest) : penalty;
+  // The automatic one above that (the study's 1e-3 in other units than its own): the floor,
+  // where the shipped scenes in millimetres solve, so that they solve alike in any units.
+  if (settings.exact() && settings.penalty == 0 && penalty > softest && floor > 0) solve = floor;
+  solvePenalty_ = std::max(solve, floor);
+  compliance_ = settings.exact() ? 0.0 : penalty;
+  if (!settings.exact() && penalty > ContactSettings::kSoftestPenalty * hMin / c)
+    softPenaltyWarning_ = format("%g lies above %g h / c = %.3g (h = %.3g, the shortest contact face edge; c = %g): "
+                                 "the body sinks into the capstan by about eps2 x the contact pressure, %.3g h at a "
+                                 "pressure of c (0, the default, scales with h / c in any units)",
+                                 penalty, ContactSettings::kSoftestPenalty, ContactSettings::kSoftestPenalty * hMin / c,
+                                 hMin, c, penalty * c / hMin);
 }
 
 void ContactEffect::setInterval(double, double tEnd) { time_ = tEnd; }

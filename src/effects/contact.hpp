@@ -31,6 +31,8 @@ class ContactEffect : public Effect {
   const std::string& quadratureWarning() const { return quadratureWarning_; }
   // Faces near the capstan longer than its diameter: what the run warns of (empty otherwise).
   const std::string& coarseFacesWarning() const { return coarseFacesWarning_; }
+  // A plain penalty soft for this mesh and material (empty if none).
+  const std::string& softPenaltyWarning() const { return softPenaltyWarning_; }
   Kokkos::View<double*> multipliers() override {
     return augmented() ? lambda_ : Kokkos::View<double*>();
   }
@@ -117,6 +119,7 @@ class ContactEffect : public Effect {
   double time_ = 0;
   std::string quadratureWarning_;
   std::string coarseFacesWarning_;
+  std::string softPenaltyWarning_;
   bool predicting_ = false;
   double solvePenalty_ = 1e-3;  // eps of the Newton solves
   double compliance_ = 1e-3;    // kappa: g = kappa t_n at the fixed point (0: exact contact)

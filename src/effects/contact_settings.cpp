@@ -7,7 +7,11 @@ const std::vector<std::pair<const char*, ContactSettings::Method>> ContactSettin
 
 void ContactSettings::declare(Teuchos::ParameterList& contact) {
   contact.set("Method", std::string("Penalty"), "Penalty | Augmented Lagrangian");
-  contact.set("Penalty", 1e-3, "eps2 > 0: penetration per unit contact pressure");
+  contact.set("Penalty", 0.0,
+              "eps2 >= 0: penetration per unit contact pressure; 0 = automatic: 2e-3 h / c for Penalty (h the "
+              "smallest candidate face edge; 1e-3 on G1), the same answer in any consistent units; 1e-3 for the "
+              "Augmented Lagrangian, whose answer does not depend on it and whose solves hold it between "
+              "Minimum Solve Penalty and 1e-1 h / c");
   contact.set("Penetration Tolerance", 0.0,
               "Multiplier loop (augmented Lagrangian, or a penalty solved at a larger penalty): "
               "stop when the penetration (or its error against the penalty answer) is below "
@@ -35,7 +39,7 @@ ContactSettings ContactSettings::parse(const Teuchos::ParameterList& ct, const s
                                        const ParameterReader& r) {
   ContactSettings s;
   s.method = r.choice(ct, path, "Method", methods);
-  s.penalty = r.positive(ct, path, "Penalty");
+  s.penalty = r.nonNegative(ct, path, "Penalty");
   s.penetrationTolerance = r.nonNegative(ct, path, "Penetration Tolerance");
   s.minimumSolvePenalty = r.finite(ct, path, "Minimum Solve Penalty");
   s.quadrature = r.choice(ct, path, "Quadrature",
@@ -57,7 +61,8 @@ ContactSettings ContactSettings::parse(const Teuchos::ParameterList& ct, const s
 // points (docs/contact.md, "Contact points: Gauss or nodal").
 ContactSettings::Quadrature ContactSettings::resolvedQuadrature(double hMin, double c, bool exactStick) const {
   if (quadrature != Quadrature::Auto) return quadrature;
-  return exact() || exactStick || penalty < kGaussPenaltyLimit * hMin / c ? Quadrature::Nodal : Quadrature::Gauss2x2;
+  return exact() || exactStick || resolvedPenalty(hMin, c) < kGaussPenaltyLimit * hMin / c ? Quadrature::Nodal
+                                                                                           : Quadrature::Gauss2x2;
 }
 
 }  // namespace capstan

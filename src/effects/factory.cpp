@@ -14,7 +14,7 @@ namespace capstan {
 SceneEffects buildEffects(const Mesh& mesh, const Scene& scene) {
   SceneEffects out;
   const double epsSolve =
-      std::max(scene.pressurePenalty, scene.solver.minimumSolvePenalty / scene.c);
+      SolverSettings::solvePenalty(scene.pressurePenalty, scene.solver.minimumSolvePenalty, scene.c);
   auto bricks = std::make_unique<BrickEffect>(mesh, scene.c, epsSolve,
                                               scene.solver.volumeTolerance);
   out.bricks = bricks.get();
