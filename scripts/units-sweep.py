@@ -22,8 +22,8 @@ INPUTS = os.path.join(HERE, "..", "inputs")
 SYSTEMS = [("si", 1e-3, 1e6, 1.0), ("time", 1.0, 1.0, 10.0), ("odd", 37.0, 3e-4, 0.02)]
 
 
-def convert(src, dst, L, S, T):
-    """SRC written in other units to DST."""
+def convert(src, dst, L, S, T, drop=()):
+    """SRC written in other units to DST; DROP: parameter names left out (to their defaults)."""
     F = S * L * L
     by_name = {"Min": L, "Max": L, "Center": L, "Inner Radius": L, "Outer Radius": L, "Length": L,
                "c": S, "Pressure Penalty": 1 / S, "Body Force": S / L, "Stiffness": S / L, "Axis Point": L,
@@ -45,6 +45,9 @@ def convert(src, dst, L, S, T):
                 walk(child, child.get("name"))
                 continue
             name = child.get("name")
+            if name in drop:
+                node.remove(child)
+                continue
             factor = in_contact.get(name) if parent == "Contact" else by_name.get(name)
             if factor is None or child.get("type") not in ("double", "Array(double)"):
                 continue

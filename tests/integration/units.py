@@ -10,55 +10,22 @@ depend on them (the pressure loop, exact contact), and the solves clamp them: th
 take the same Newton iterations and give the same forces. A plain penalty has its own answer,
 and the run warns that it is soft for the mesh.
 """
+import importlib.util
 import os
-import xml.etree.ElementTree as ET
 
 import capstan_test
 
 T = capstan_test.Test("units", __doc__)
 L, S = 1e-3, 1e6
-F = S * L * L
-# Each parameter's dimension by its name (its sublist where the name alone is ambiguous).
-SCALE = {
-    "Min": L, "Max": L, "Center": L, "Inner Radius": L, "Outer Radius": L, "Length": L,
-    "c": S, "Pressure Penalty": 1 / S, "Body Force": S / L,
-    "Stiffness": S / L, "Axis Point": L, "Force": F, "Torque": F * L,
-    "Radius": L, "Penetration Tolerance": L, "Tangential Penalty": L / S,
-    "Regularization": L,
-}
-SCALE_IN = {("Contact", "Penalty"): L / S, ("Contact", "Smoothing"): S, ("Contact", "Minimum Solve Penalty"): L / S,
-            ("Supports", "Velocity"): L, ("Capstans", "Velocity"): L}
+# The scenes are rewritten by scripts/units-sweep.py's converter (each parameter's dimension by its name).
+_spec = importlib.util.spec_from_file_location("units_sweep", os.path.join(T.inputs, "..", "scripts", "units-sweep.py"))
+units_sweep = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(units_sweep)
 
 
 def to_si(src, dst, drop=()):
     """Writes SRC in metres and pascals to DST; DROP: parameter names left to their defaults."""
-    tree = ET.parse(src)
-
-    def walk(node, path):
-        for child in list(node):
-            if child.tag == "ParameterList":
-                walk(child, path + [child.get("name")])
-                continue
-            name = child.get("name")
-            if name in drop:
-                node.remove(child)
-                continue
-            factor = SCALE_IN.get((path[-1] if path else "", name)) or SCALE_IN.get((path[1] if len(path) > 1 else "", name))
-            if factor is None and name == "Velocity":
-                factor = L
-            if factor is None:
-                factor = SCALE.get(name)
-            if factor is None or child.get("type") not in ("double", "Array(double)"):
-                continue
-            value = child.get("value")
-            if child.get("type") == "double":
-                child.set("value", repr(float(value) * factor))
-            else:
-                items = [float(v) * factor for v in value.strip("{} ").split(",")]
-                child.set("value", "{" + ", ".join(repr(v) for v in items) + "}")
-
-    walk(tree.getroot(), [])
-    tree.write(dst)
+    units_sweep.convert(src, dst, L, S, 1.0, drop)
     return dst
 
 
