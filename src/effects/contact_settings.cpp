@@ -18,7 +18,8 @@ void ContactSettings::declare(Teuchos::ParameterList& contact) {
               "this; 0 = 1e-4 x the smallest candidate face edge");
   contact.set("Max Augmentations", 50, "Augmented Lagrangian: most multiplier updates per step");
   contact.set("Minimum Solve Penalty", -1.0,
-              "Newton solves use eps = max(Penalty, this), and multiplier updates then reach the "
+              "Newton solves use eps = max(Penalty, this) (the Augmented Lagrangian's at most 1e-1 h / c), "
+              "and multiplier updates then reach the "
               "answer of Penalty (or exact contact): a well-conditioned solve for any Penalty. "
               "< 0: automatic, 1e-2 h / c with the Nodal rule (h the smallest candidate face edge), "
               "off with Gauss rules; 0: off");
