@@ -1,14 +1,14 @@
 #!/usr/bin/env python3
 """Units: a scene in metres and pascals gives the answer of the same scene in millimetres
-and megapascals, with the penalties left at their defaults (docs/numerics.md, "Penalties in
-any units").
+and megapascals, with its penalties scaled or left at their automatic defaults
+(docs/contact.md and docs/numerics.md, "Penalties in any units").
 
 Every length is scaled by L = 1e-3 and every stress by S = 1e6, so forces (S L^2) keep their
-values. The defaults of the pressure and contact penalties (1e-3) suit c ~ 1 and faces ~ 1;
-in metres and pascals they are 1e9 and 1e12 times too soft. Their converged answers do not
-depend on them (the pressure loop, exact contact), and the solves clamp them: the runs must
-take the same Newton iterations and give the same forces. A plain penalty has its own answer,
-and the run warns that it is soft for the mesh.
+values. The study's penalties (1e-3) suit c ~ 1 and faces ~ 1; in metres and pascals they
+are 1e9 and 1e12 times too soft. Their converged answers do not depend on them (the pressure
+loop, exact contact), and the solves hold them within bounds scaled by h / c: the runs must
+take the same Newton iterations and give the same forces. A plain penalty has its own
+answer: its automatic default scales with h / c, and a soft one written into the scene warns.
 """
 import importlib.util
 import os
