@@ -675,6 +675,22 @@ TEST_F(SceneTest, ContactPenaltyAutomatic) {
   EXPECT_TRUE(own.warnings.empty());
 }
 
+// The solves' eps: at least the floor (1e-2 h / c with the nodal rule), the augmented
+// Lagrangian's at most 1e-1 h / c, its automatic 1e-3 at the floor where 1e-3 lies above that.
+TEST_F(SceneTest, ContactSolvePenaltyBounds) {
+  const std::string g1 = std::string(CAPSTAN_INPUTS_DIR) + "/seed/g1.xml";  // augmented Lagrangian
+  const std::string P = "Capstans/capstan/Contact/Penalty=";
+  const auto exact = [&](const std::string& eps2) { return loadScene(g1, {P + eps2}, "").capstans.at(0).contact; };
+  EXPECT_DOUBLE_EQ(exact("0").solvePenalty(0.5, 1.0, true), 5e-3);       // G1: the floor above 1e-3
+  EXPECT_DOUBLE_EQ(exact("0").solvePenalty(0.036, 1.0, true), 1e-3);     // the Hertz ring: 1e-3 itself
+  EXPECT_DOUBLE_EQ(exact("0").solvePenalty(5e-4, 1e6, true), 5e-12);     // G1 in metres: the floor
+  EXPECT_DOUBLE_EQ(exact("1e-3").solvePenalty(5e-4, 1e6, true), 5e-11);  // 1e-3 written: the cap
+  EXPECT_DOUBLE_EQ(exact("10").solvePenalty(0.5, 1.0, true), 5e-2);
+  const auto plain = loadScene(g1, {P + "10", "Capstans/capstan/Contact/Method=Penalty"}, "").capstans.at(0).contact;
+  EXPECT_DOUBLE_EQ(plain.solvePenalty(0.5, 1.0, true), 10.0);  // its own answer: no cap
+  EXPECT_DOUBLE_EQ(plain.solvePenalty(0.5, 1.0, false), 10.0);
+}
+
 // Tanh or Arctan finer than 3e-7 of the capstan's surface speed is solved as
 // Coulomb, with a warning; at the floor and above, and with no speed to compare
 // with, as written.

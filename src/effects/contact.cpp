@@ -85,24 +85,8 @@ ContactEffect::ContactEffect(const std::string& name, const Mesh& mesh, const st
                                   "multiplier loop crawls (docs/contact.md); Auto gives it Nodal",
                                   gauss);
   }
-  // Automatic floor for the nodal rule only: with Gauss points the penalty
-  // answer approaches an over-constrained one as eps2 -> 0 (flat faces cannot
-  // touch a curved capstan at every Gauss point), and the multiplier loop
-  // crawls (measured on G1: eps2 = 1e-4 needed 100+ passes per step).
-  const bool nodal = rule() == kernels::FaceRule::Nodal;
-  const double floor = settings.minimumSolvePenalty >= 0 ? settings.minimumSolvePenalty
-                       : nodal                           ? 1e-2 * hMin / c
-                                                         : 0.0;
-  // The augmented Lagrangian's answer does not depend on eps2: a softer solve than
-  // kSoftestExactSolve h / c is stiffened to it (a scene in metres and pascals with a penalty
-  // meant for millimetres and megapascals stalled: docs/contact.md, "Penalties in any units").
   const double penalty = settings.resolvedPenalty(hMin, c);
-  const double softest = ContactSettings::kSoftestExactSolve * hMin / c;
-  double solve = settings.exact() ? std::min(penalty, softest) : penalty;
-  // The automatic one above that (the study's 1e-3 in other units than its own): the floor,
-  // where the shipped scenes in millimetres solve, so that they solve alike in any units.
-  if (settings.exact() && settings.penalty == 0 && penalty > softest && floor > 0) solve = floor;
-  solvePenalty_ = std::max(solve, floor);
+  solvePenalty_ = settings.solvePenalty(hMin, c, rule() == kernels::FaceRule::Nodal);
   compliance_ = settings.exact() ? 0.0 : penalty;
   if (!settings.exact() && penalty > ContactSettings::kSoftestPenalty * hMin / c)
     softPenaltyWarning_ = format("%g lies above %g h / c = %.3g (h = %.3g, the shortest contact face edge; c = %g): "

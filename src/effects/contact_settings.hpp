@@ -54,6 +54,9 @@ struct ContactSettings {
   double resolvedPenalty(double hMin, double c) const {
     return penalty > 0 ? penalty : exact() ? kStudyPenalty : kAutomaticPenalty * hMin / c;
   }
+  // The eps of the Newton solves: eps2, at least the floor (Minimum Solve Penalty; automatic
+  // 1e-2 h / c with the nodal rule), the augmented Lagrangian's at most kSoftestExactSolve h / c.
+  double solvePenalty(double hMin, double c, bool nodal) const;
 
   static void declare(Teuchos::ParameterList& contact);
   static ContactSettings parse(const Teuchos::ParameterList& contact, const std::string& path,
