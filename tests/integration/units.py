@@ -42,7 +42,8 @@ G1 = T.input("seed/g1.xml")
 _, mm, _ = T.run_scene(G1, "g1-mm")
 for label, drop in (("the scene's penalties, scaled", ()), ("the penalties' defaults", ("Penalty", "Pressure Penalty"))):
     si_file = to_si(G1, os.path.join(T.dir, f"g1-si-{len(drop)}.xml"), drop)
-    p, si, _ = T.run_scene(si_file, f"g1-si-{len(drop)}", quiet=False)
+    p, si, out = T.run_scene(si_file, f"g1-si-{len(drop)}", quiet=False)
+    T.conforms(out, si_file)
     if mm is None or si is None or not si["converged"]:
         T.check(False, f"G1 in metres and pascals, {label}: converged ({p.stderr.strip()[-300:]!r})")
         continue
@@ -89,7 +90,8 @@ for penalty, warned in (("1e-2", False), ("0.014", True)):
 SLICE = T.input("pinch-roller-slice-steady.xml")
 _, mm, _ = T.run_scene(SLICE, "slice-mm")
 si_file = to_si(SLICE, os.path.join(T.dir, "slice-si.xml"))
-p, si, _ = T.run_scene(si_file, "slice-si", quiet=False)
+p, si, out = T.run_scene(si_file, "slice-si", quiet=False)
+T.conforms(out, si_file)
 if mm is not None and si is not None and si["converged"]:
     r_mm, r_si = (x["steps"][-1]["supports"]["core"]["speed_ratio"] for x in (mm, si))
     T.check(abs(r_mm - r_si) < 1e-8, f"steady slice: speed ratio {r_si:.10f} against {r_mm:.10f}")
