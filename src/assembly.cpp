@@ -229,7 +229,8 @@ void Assembly::buildTangentSinks() {
 RCP<FEMatrix> Assembly::createMatrix() const { return rcp(new FEMatrix(graph_)); }
 
 void Assembly::chainRows(const Effect& e, const Matrix& values, std::vector<size_t>& rowStart,
-                         std::vector<GO>& cols, std::vector<double>& vals, const std::vector<int>* entities) const {
+                         std::vector<GO>& cols, std::vector<double>& vals, const std::vector<int>* entities,
+                         bool residual) const {
   auto dofs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), e.local().dofs);
   auto v = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), values);
   auto gid = [&](int dof) { return overlapDofMap_->getGlobalElement(layout_.overlapLid(dof)); };
@@ -248,7 +249,9 @@ void Assembly::chainRows(const Effect& e, const Matrix& values, std::vector<size
         if (!constraints_.held(d)) add(gid(d), v(k, j));
         continue;
       }
-      cores_.forEachFreeUnknown(d, [&](int coreDof, double B) { add(gid(coreDof), v(k, j) * B); });
+      const auto f = [&](int coreDof, double B) { add(gid(coreDof), v(k, j) * B); };
+      if (residual) cores_.forEachFreeRow(d, f);
+      else cores_.forEachFreeUnknown(d, f);
     }
     rowStart.push_back(cols.size());
   }
@@ -434,7 +437,7 @@ void Assembly::coupleCores(Vector* f, FEMatrix* W, Vector* Kz) {
   }
   if (Kz) {
     auto yd = Kz->getDataNonConst();
-    const auto sums = cores_.sums(yd.getRawPtr());  // over the node rows (K z's owned sums)
+    const auto sums = cores_.rowSums(yd.getRawPtr());  // over the node rows (K z's owned sums)
     for (LO d = 0; d < LO(yd.size()); ++d) {
       const int a = layout_.assemblyDof(d) - layout_.nodeDofs;
       if (a >= 0) yd[d] = a % 6 < 4 ? sums[a / 6][a % 6] : 0.0;

@@ -80,9 +80,11 @@ class Assembly {
 
   // Effect e's per-entity vectors (values: entities x dofs, e.g. d v_e / d x) as sparse rows over
   // dofMap()'s free dofs, by the matrix's chain rule (held dofs drop): row r is
-  // cols/vals[rowStart[r], rowStart[r + 1]); entities: row r's entity, if given.
+  // cols/vals[rowStart[r], rowStart[r + 1]); entities: row r's entity, if given. A gradient
+  // takes the columns' chain; a residual's entries (residual = true: a column dR/dmu) the rows'
+  // (the cores' rows as the residual holds them: the torque over the core's radius).
   void chainRows(const Effect& e, const Matrix& values, std::vector<size_t>& rowStart, std::vector<GO>& cols,
-                 std::vector<double>& vals, const std::vector<int>* entities = nullptr) const;
+                 std::vector<double>& vals, const std::vector<int>* entities = nullptr, bool residual = false) const;
 
   // Reaction force of each constrained support on the body, from the last
   // evaluation (global sum).

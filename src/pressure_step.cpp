@@ -69,7 +69,11 @@ void PressureStep::fillRows() {
                               [](const ConstraintRows& r) { return r.size() > 0 && r.column.extent(0) > 0; }),
       anyColumnGlobal = 0;
   Teuchos::reduceAll(*comm, Teuchos::REDUCE_MAX, anyColumn, Teuchos::outArg(anyColumnGlobal));
-  const bool ownColumns = anyColumnGlobal > 0;
+  // A free core's torque row takes a residual's entries otherwise than its rotation's column
+  // takes a gradient's (over the radius; steady: omega moves no face node): columns apart.
+  const bool ownColumns = anyColumnGlobal > 0 ||
+                          std::any_of(assembly_.rigidCores().begin(), assembly_.rigidCores().end(),
+                                      [](const RigidCore& c) { return c.free[3]; });
   std::vector<size_t> allColumnStart(1, 0);
   std::vector<GO> allColumnCols;
   std::vector<double> allColumnVals;
@@ -79,7 +83,9 @@ void PressureStep::fillRows() {
     if (r.size() == 0) continue;
     assembly_.chainRows(*effects[i], r.gradient, start, cols, vals, &r.entity);
     const bool column = r.column.extent(0) > 0;
-    if (column) assembly_.chainRows(*effects[i], r.column, columnStart, columnCols, columnVals, &r.entity);
+    if (ownColumns)  // dR/dmu_j: the row's own column, or force_j gradient_j, chained as residuals
+      assembly_.chainRows(*effects[i], column ? r.column : r.gradient, columnStart, columnCols, columnVals,
+                          &r.entity, true);
     auto grad = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), column ? r.column : r.gradient);
     for (size_t k = 0; k < r.size(); ++k, ++j) {
       double norm2 = 0;
@@ -90,15 +96,10 @@ void PressureStep::fillRows() {
       // w_j = |dR/dmu_j| / |S_j|.
       w[j] = empty ? 0.0 : (column ? 1.0 : std::fabs(r.force[k])) * std::sqrt(norm2) / std::fabs(r.schur[k]);
       if (ownColumns) {
-        if (column) {
-          allColumnCols.insert(allColumnCols.end(), columnCols.begin() + long(columnStart[k]),
-                               columnCols.begin() + long(columnStart[k + 1]));
-          allColumnVals.insert(allColumnVals.end(), columnVals.begin() + long(columnStart[k]),
-                               columnVals.begin() + long(columnStart[k + 1]));
-        } else {
-          allColumnCols.insert(allColumnCols.end(), cols.begin() + long(start[k]), cols.begin() + long(start[k + 1]));
-          for (size_t l = start[k]; l < start[k + 1]; ++l) allColumnVals.push_back(r.force[k] * vals[l]);
-        }
+        const double scale = column ? 1.0 : r.force[k];
+        allColumnCols.insert(allColumnCols.end(), columnCols.begin() + long(columnStart[k]),
+                             columnCols.begin() + long(columnStart[k + 1]));
+        for (size_t l = columnStart[k]; l < columnStart[k + 1]; ++l) allColumnVals.push_back(scale * columnVals[l]);
         allColumnStart.push_back(allColumnCols.size());
       }
       sInv[j] = empty ? 0.0 : 1 / (w[j] * r.schur[k]);

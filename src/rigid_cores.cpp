@@ -22,11 +22,24 @@ RigidCores::RigidCores(const Mesh& mesh, const Scene& scene) : mesh_(mesh), stea
     core.torque = s.torque, core.rampTime = s.rampTime, core.torqueRampTime = s.torqueRampTime;
     core.free = {s.freeTranslation[0], s.freeTranslation[1], s.freeTranslation[2], s.rotation == SupportSpec::Rotation::Free};
     core.firstDof = nodeDofs + kCoreUnknowns * int(cores_.size());
-    for (int n : mesh.faceNodes(s.face))
+    double radius = 0;  // the largest over the ranks: the same on any number of ranks
+    for (int n : mesh.faceNodes(s.face)) {
       if (coreOfNode_[n] < 0) coreOfNode_[n] = int(cores_.size());
+      radius = std::max(radius, distanceFromAxis(core, &mesh.X[3 * n]));
+    }
+    Teuchos::reduceAll(*mesh.comm, Teuchos::REDUCE_MAX, radius, Teuchos::outArg(core.radius));
+    if (!(core.radius > 0)) core.radius = 1;  // a face on its axis carries no torque
     cores_.push_back(core);
   }
   layout_ = DofLayout(mesh, cores_.size());
+}
+
+double RigidCores::distanceFromAxis(const RigidCore& core, const double* X) {
+  double r[3], along = 0;
+  for (int i = 0; i < 3; ++i) r[i] = X[i] - core.axisPoint[i], along += r[i] * core.axisDirection[i];
+  double r2 = 0;
+  for (int i = 0; i < 3; ++i) r2 += std::pow(r[i] - along * core.axisDirection[i], 2);
+  return std::sqrt(r2);
 }
 
 int RigidCores::find(const std::string& name) const {
@@ -96,6 +109,13 @@ std::vector<std::array<double, 5>> RigidCores::sums(const double* v) const {
   std::vector<std::array<double, 5>> out(nc);
   for (size_t c = 0; c < nc; ++c)
     for (int k = 0; k < 5; ++k) out[c][k] = global[5 * c + k];
+  return out;
+}
+
+std::vector<std::array<double, 4>> RigidCores::rowSums(const double* v) const {
+  const auto s = sums(v);
+  std::vector<std::array<double, 4>> out(s.size());
+  for (size_t c = 0; c < s.size(); ++c) out[c] = {s[c][0], s[c][1], s[c][2], s[c][3] / cores_[c].radius};
   return out;
 }
 
@@ -217,6 +237,8 @@ void RigidCores::assembleCoupling(FEMatrix& W, const std::vector<std::unique_ptr
       if (p == q && q % 4 == 3 && layout_.coresOwned) v += cores_[q / 4].geometric;
       if (freeCoreDof(p) && v != 0) cols.push_back(columnOf[coreDof(p)]), vals.push_back(v);
     }
+    if (q % 4 == 3)  // the torque balance as the residual writes it: over the core's radius
+      for (double& v : vals) v /= cores_[q / 4].radius;
     if (!cols.empty()) add(layout_.overlapLid(coreDof(q)));
   }
 }

@@ -46,6 +46,9 @@ struct RigidCore {
   std::array<double, 3> forceOnBody{};
   double torqueOnBody = 0;
   double geometric = 0;  // sum over the face's nodes of R . w (the theta-theta tangent term)
+  // The face's largest distance from the axis. The torque balance's row is divided by it (a
+  // force at the face), so Newton's merit |R| weighs it like the force rows in any units.
+  double radius = 1;
   // External loads at time t: ramped linearly to rampTime (the torque to
   // torqueRampTime), then held.
   double loadFactor(double t) const { return std::min(1.0, t / rampTime); }
@@ -99,8 +102,10 @@ class RigidCores {
   void translate(const Teuchos::ArrayRCP<double>& u, size_t c, const std::array<double, 3>& delta) const;
 
   // Sums over the owned core nodes of v (owned values, a residual or K z): per
-  // core {force (3), torque, R . w}, global (collective).
+  // core {force (3), torque, R . w}, global (collective).  rowSums: the same as
+  // the cores' rows hold them ({force (3), torque / radius}).
   std::vector<std::array<double, 5>> sums(const double* v) const;
+  std::vector<std::array<double, 4>> rowSums(const double* v) const;
   // The reactions at the face nodes from the owned residual (collective).
   void setReactions(const double* ownedResidual);
   // The residual of a core's free unknown (assembly dof `dof`) at time t: the
@@ -110,7 +115,7 @@ class RigidCores {
     const int j = (dof - layout_.nodeDofs) % 6;
     if (j == 3 && core.holding()) return core.angularVelocity - core.heldAngularVelocity;
     return j < 3 ? core.forceOnBody[j] - core.loadFactor(t) * core.force[j]
-                 : core.torqueOnBody - core.torqueFactor(t) * core.torque;
+                 : (core.torqueOnBody - core.torqueFactor(t) * core.torque) / core.radius;
   }
 
   // The matrix graph. findCoupling: each stiff effect's entities with a face
@@ -142,6 +147,17 @@ class RigidCores {
     for (int q = 0; q < 4; ++q)
       if (core.free[q] && (q == 3 || q == dof % 3)) f(core.firstDof + q, B[q]);
   }
+  // The free cores' rows a residual entry at a face-node dof adds to, f(core dof, factor): its
+  // force component, and the torque balance by its lever arm over the core's radius.
+  template <class F>
+  void forEachFreeRow(int dof, const F& f) const {
+    const RigidCore& core = cores_[coreOfNode_[dof / 3]];
+    const auto B = chain(dof);
+    for (int q = 0; q < 3; ++q)
+      if (core.free[q] && q == dof % 3) f(core.firstDof + q, B[q]);
+    if (core.free[3] && !core.holding()) f(core.firstDof + 3, B[3] / core.radius);
+  }
+
 
   // The chain rule at the cores' face nodes: the kept element-matrix entries
   // that touch a face node (sinks[i].kept for effect i), carried to the cores'
@@ -151,6 +167,7 @@ class RigidCores {
                         const Constraints& constraints);
 
  private:
+  static double distanceFromAxis(const RigidCore& core, const double* X);
   const Mesh& mesh_;
   bool steady_ = false;  // Analysis/Type = Steady Rolling
   DofLayout layout_;

@@ -102,7 +102,8 @@ inline StepCheck checkPressureStep(Assembly& assembly, NewtonSolver& newton, con
     std::vector<GO> cols;
     std::vector<double> vals;
     const bool own = rows.column.extent(0) > 0;
-    if (rows.size() > 0) assembly.chainRows(*assembly.effects()[i], own ? rows.column : rows.gradient, start, cols, vals, &rows.entity);
+    if (rows.size() > 0)
+      assembly.chainRows(*assembly.effects()[i], own ? rows.column : rows.gradient, start, cols, vals, &rows.entity, true);
     // Summed over this rank's rows by global dof, then exported (ADD): a row
     // reaches dofs other ranks own.
     std::map<GO, double> byDof;

@@ -6,9 +6,14 @@
 #include <Tpetra_Core.hpp>
 #include <gtest/gtest.h>
 
+#include <Teuchos_CommHelpers.hpp>
+
+#include <algorithm>
 #include <cmath>
 
 #include "assembly.hpp"
+#include "newton.hpp"
+#include "pressure_step_check.hpp"
 #include "errors.hpp"
 #include "roller_scene.hpp"
 #include "scene.hpp"
@@ -84,6 +89,25 @@ TEST(RigidCore, CoupledTangentMatchesCentralDifferences) {
   EXPECT_GT(std::fabs(core.forceOnBody[1]), 1e-3);
   EXPECT_GT(std::fabs(core.torqueOnBody), 1e-4);
   EXPECT_GT(std::fabs(core.rotation), 1e-3);
+  // The torque balance's row is a force: the torque over the core's radius, in the residual
+  // as in W (the differences below check W's row against it).
+  {
+    // The core's radius: its face's largest distance from its (skewed) axis, over the ranks.
+    double radius = 0, global = 0;
+    for (int n : mesh.faceNodes("inner")) {
+      double r[3], along = 0, r2 = 0;
+      for (int i = 0; i < 3; ++i) r[i] = mesh.X[3 * n + i] - core.axisPoint[i], along += r[i] * core.axisDirection[i];
+      for (int i = 0; i < 3; ++i) r2 += std::pow(r[i] - along * core.axisDirection[i], 2);
+      radius = std::max(radius, std::sqrt(r2));
+    }
+    Teuchos::reduceAll(*mesh.comm, Teuchos::REDUCE_MAX, radius, Teuchos::outArg(global));
+    EXPECT_GT(global, m.innerRadius);  // the axis is off the mesh's centre
+    EXPECT_NEAR(core.radius, global, 1e-12 * global);
+  }
+  if (assembly.ownedCoreDof(0, 3) >= 0)
+    EXPECT_NEAR(f.getData()[assembly.ownedCoreDof(0, 3)],
+                (core.torqueOnBody - core.torqueFactor(0.5) * core.torque) / core.radius,
+                1e-12 * std::fabs(core.torqueOnBody) / core.radius);
   W->apply(v, Wv);
   const double h = 1e-6;
   trial.update(1.0, u, h, v, 0.0);
@@ -109,6 +133,35 @@ TEST(RigidCore, CoupledTangentMatchesCentralDifferences) {
   if (assembly.ownedCoreDof(0, 0) >= 0) {
     EXPECT_GT(scale, 1e-3);
     EXPECT_LT(worst, 1e-6 * scale);
+  }
+}
+
+// The saddle-point step with a free core, quasi-static: a multiplier's column reaches the torque
+// balance's row as the residual holds it (over the core's radius), its gradient the rotation's
+// column by the lever arm alone (tests/pressure_step_check.hpp).
+TEST(RigidCore, SaddlePointStepReachesTheTorqueRow) {
+  const Scene scene = parseScene(kScene, "rigid-core-test.xml",
+                                 {"Capstans/capstan/Friction/Law=Coulomb", "Capstans/capstan/Friction/Tangential Penalty=0.5",
+                                  "Capstans/capstan/Contact/Method=Augmented Lagrangian",
+                                  "Capstans/capstan/Friction/Coefficient=5"},
+                                 "");
+  const auto& m = scene.mesh;
+  AnnulusGenerator gen(m.center, m.innerRadius, m.outerRadius, m.length, m.cells);
+  Mesh mesh = distributeMesh(gen, Tpetra::getDefaultComm());
+  Assembly assembly(mesh, scene);
+  NewtonSolver newton(assembly, scene.solver);
+  const auto map = assembly.dofMap();
+  Vector u(map), f(map);
+  fill(assembly, mesh, u, 0.02, 0.0);
+  assembly.setInterval(0.0, 0.5);
+  assembly.applyConstraints(u, 0.5);
+  auto W = newton.matrix();
+  ASSERT_TRUE(assembly.evaluate(u, &f, W.get()));
+  const test::StepCheck check = test::checkPressureStep(assembly, newton, u, f, *W);
+  ASSERT_TRUE(check.columnError.count("brick"));
+  for (const auto& [name, error] : check.columnError) {
+    std::printf("%s: columns %.2e, rows %.2e\n", name.c_str(), error, check.rowError.at(name));
+    EXPECT_LT(error, 1e-8) << name;
   }
 }
 
