@@ -27,6 +27,13 @@ namespace {
 using capstan::test::kRollerScene;
 const char* const kScene = kRollerScene;
 
+// The scene's annulus, distributed over the ranks.
+Mesh annulusMesh(const Scene& scene) {
+  const auto& m = scene.mesh;
+  AnnulusGenerator gen(m.center, m.innerRadius, m.outerRadius, m.length, m.cells);
+  return distributeMesh(gen, Tpetra::getDefaultComm());
+}
+
 TEST(RigidCoreKernel, FollowerDerivativesMatchCentralDifferences) {
   double d[3] = {0.2, -0.3, 0.9};
   const double n = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
@@ -67,9 +74,7 @@ void fill(const Assembly& a, const Mesh& mesh, Vector& v, double scale, double p
 
 TEST(RigidCore, CoupledTangentMatchesCentralDifferences) {
   const Scene scene = parseScene(kScene, "rigid-core-test.xml", {}, "");
-  const auto& m = scene.mesh;
-  AnnulusGenerator gen(m.center, m.innerRadius, m.outerRadius, m.length, m.cells);
-  Mesh mesh = distributeMesh(gen, Tpetra::getDefaultComm());
+  Mesh mesh = annulusMesh(scene);
   Assembly assembly(mesh, scene);
   const auto map = assembly.dofMap();
   Vector u(map), v(map), f(map), fp(map), fm(map), Wv(map), trial(map);
@@ -101,13 +106,14 @@ TEST(RigidCore, CoupledTangentMatchesCentralDifferences) {
       radius = std::max(radius, std::sqrt(r2));
     }
     Teuchos::reduceAll(*mesh.comm, Teuchos::REDUCE_MAX, radius, Teuchos::outArg(global));
-    EXPECT_GT(global, m.innerRadius);  // the axis is off the mesh's centre
+    EXPECT_GT(global, scene.mesh.innerRadius);  // the axis is off the mesh's centre
     EXPECT_NEAR(core.radius, global, 1e-12 * global);
   }
-  if (assembly.ownedCoreDof(0, 3) >= 0)
+  if (assembly.ownedCoreDof(0, 3) >= 0) {
     EXPECT_NEAR(f.getData()[assembly.ownedCoreDof(0, 3)],
                 (core.torqueOnBody - core.torqueFactor(0.5) * core.torque) / core.radius,
                 1e-12 * std::fabs(core.torqueOnBody) / core.radius);
+  }
   W->apply(v, Wv);
   const double h = 1e-6;
   trial.update(1.0, u, h, v, 0.0);
@@ -145,9 +151,7 @@ TEST(RigidCore, SaddlePointStepReachesTheTorqueRow) {
                                   "Capstans/capstan/Contact/Method=Augmented Lagrangian",
                                   "Capstans/capstan/Friction/Coefficient=5"},
                                  "");
-  const auto& m = scene.mesh;
-  AnnulusGenerator gen(m.center, m.innerRadius, m.outerRadius, m.length, m.cells);
-  Mesh mesh = distributeMesh(gen, Tpetra::getDefaultComm());
+  Mesh mesh = annulusMesh(scene);
   Assembly assembly(mesh, scene);
   NewtonSolver newton(assembly, scene.solver);
   const auto map = assembly.dofMap();
@@ -170,9 +174,7 @@ TEST(RigidCore, RigidMotionLeavesNoResidual) {
   // is a rigid motion: no stress, no reaction, no residual.
   Scene scene = parseScene(kScene, "rigid-core-test.xml", {"Supports/core/Force={0,0,0}", "Supports/core/Torque=0"}, "");
   scene.capstans.clear();
-  const auto& m = scene.mesh;
-  AnnulusGenerator gen(m.center, m.innerRadius, m.outerRadius, m.length, m.cells);
-  Mesh mesh = distributeMesh(gen, Tpetra::getDefaultComm());
+  Mesh mesh = annulusMesh(scene);
   Assembly assembly(mesh, scene);
   Vector u(assembly.dofMap()), f(assembly.dofMap());
   assembly.setInterval(0.0, 1.0);
@@ -229,9 +231,7 @@ TEST(StreamlineShift, MovesMultipliersAlongTheRings) {
                                   "Capstans/capstan/Contact/Method=Augmented Lagrangian",
                                   "Capstans/capstan/Friction/Law=Coulomb"},
                                  "");
-  const auto& m = scene.mesh;
-  AnnulusGenerator gen(m.center, m.innerRadius, m.outerRadius, m.length, m.cells);
-  Mesh mesh = distributeMesh(gen, Tpetra::getDefaultComm());
+  Mesh mesh = annulusMesh(scene);
   Assembly assembly(mesh, scene);
   StreamlineShift shift(mesh, assembly.dofMap());
   const auto& core = assembly.rigidCores().at(0);

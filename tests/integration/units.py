@@ -88,12 +88,19 @@ for penalty, warned in (("1e-2", False), ("0.014", True)):
             and p.returncode == 0, f"G1, plain penalty {penalty}: {'a' if warned else 'no'} warning, exit {p.returncode} "
             f"({p.stderr.strip()[:200]!r})")
 
+def mm_and_si(scene_name, tag):
+    """Runs a shipped scene as written and in metres and pascals: (mm summary, SI summary,
+    the SI run's process), the SI output checked against interface.md."""
+    scene = T.input(scene_name)
+    _, mm, _ = T.run_scene(scene, f"{tag}-mm")
+    si_file = to_si(scene, os.path.join(T.dir, f"{tag}-si.xml"))
+    p, si, out = T.run_scene(si_file, f"{tag}-si", quiet=False)
+    T.conforms(out, si_file)
+    return mm, si, p
+
+
 # --- steady rolling: the pinch-roller slice, a rigid core with a force ------------------------
-SLICE = T.input("pinch-roller-slice-steady.xml")
-_, mm, _ = T.run_scene(SLICE, "slice-mm")
-si_file = to_si(SLICE, os.path.join(T.dir, "slice-si.xml"))
-p, si, out = T.run_scene(si_file, "slice-si", quiet=False)
-T.conforms(out, si_file)
+mm, si, p = mm_and_si("pinch-roller-slice-steady.xml", "slice")
 if mm is not None and si is not None and si["converged"]:
     r_mm, r_si = (x["steps"][-1]["supports"]["core"]["speed_ratio"] for x in (mm, si))
     T.check(abs(r_mm - r_si) < 1e-8, f"steady slice: speed ratio {r_si:.10f} against {r_mm:.10f}")
@@ -111,11 +118,7 @@ else:
 # The residual holds the torque over the core's radius (a force), so the line
 # search weighs it alike in both units. Before, as a torque, it weighed 1e-3 as much in metres:
 # 170 Newton iterations against 62.
-BRAKED = T.input("pinch-roller-braked-steady.xml")
-_, mm, _ = T.run_scene(BRAKED, "braked-mm")
-si_file = to_si(BRAKED, os.path.join(T.dir, "braked-si.xml"))
-p, si, out = T.run_scene(si_file, "braked-si", quiet=False)
-T.conforms(out, si_file)
+mm, si, p = mm_and_si("pinch-roller-braked-steady.xml", "braked")
 if mm is not None and si is not None and si["converged"]:
     n_mm, n_si = ([s["newton_iterations"] for s in x["steps"]] for x in (mm, si))
     T.check(n_si == n_mm, f"brake sweep: Newton iterations {n_si} ({sum(n_si)}) against {n_mm} ({sum(n_mm)})")
