@@ -102,7 +102,7 @@ class RigidCores {
   void translate(const Teuchos::ArrayRCP<double>& u, size_t c, const std::array<double, 3>& delta) const;
 
   // Sums over the owned core nodes of v (owned values, a residual or K z): per
-  // core {force (3), torque, R . w}, global (collective).  rowSums: the same as
+  // core {force (3), torque, R . w}, global (collective). rowSums: the same as
   // the cores' rows hold them ({force (3), torque / radius}).
   std::vector<std::array<double, 5>> sums(const double* v) const;
   std::vector<std::array<double, 4>> rowSums(const double* v) const;
