@@ -6,6 +6,7 @@
 
 #include "constraints.hpp"
 #include "scene.hpp"
+#include "vec3.hpp"
 
 namespace capstan {
 
@@ -35,11 +36,8 @@ RigidCores::RigidCores(const Mesh& mesh, const Scene& scene) : mesh_(mesh), stea
 }
 
 double RigidCores::distanceFromAxis(const RigidCore& core, const double* X) {
-  double r[3], along = 0;
-  for (int i = 0; i < 3; ++i) r[i] = X[i] - core.axisPoint[i], along += r[i] * core.axisDirection[i];
-  double r2 = 0;
-  for (int i = 0; i < 3; ++i) r2 += std::pow(r[i] - along * core.axisDirection[i], 2);
-  return std::sqrt(r2);
+  const Vec3 r = sub({X[0], X[1], X[2]}, core.axisPoint);
+  return norm(sub(r, scale(core.axisDirection, dot(r, core.axisDirection))));
 }
 
 int RigidCores::find(const std::string& name) const {
