@@ -113,7 +113,11 @@ std::vector<std::array<double, 5>> RigidCores::sums(const double* v) const {
 std::vector<std::array<double, 4>> RigidCores::rowSums(const double* v) const {
   const auto s = sums(v);
   std::vector<std::array<double, 4>> out(s.size());
-  for (size_t c = 0; c < s.size(); ++c) out[c] = {s[c][0], s[c][1], s[c][2], s[c][3] / cores_[c].radius};
+  for (size_t c = 0; c < s.size(); ++c) {
+    // A held omega's row is omega - held, which no node moves.
+    const double torqueRow = cores_[c].holding() ? 0.0 : s[c][3] / cores_[c].radius;
+    out[c] = {s[c][0], s[c][1], s[c][2], torqueRow};
+  }
   return out;
 }
 

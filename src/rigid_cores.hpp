@@ -103,7 +103,7 @@ class RigidCores {
 
   // Sums over the owned core nodes of v (owned values, a residual or K z): per
   // core {force (3), torque, R . w}, global (collective). rowSums: the same as
-  // the cores' rows hold them ({force (3), torque / radius}).
+  // the cores' rows hold them ({force (3), torque / radius}, 0 for a held omega).
   std::vector<std::array<double, 5>> sums(const double* v) const;
   std::vector<std::array<double, 4>> rowSums(const double* v) const;
   // The reactions at the face nodes from the owned residual (collective).

@@ -6,7 +6,10 @@
 #include <Tpetra_Core.hpp>
 #include <gtest/gtest.h>
 
+#include <Teuchos_CommHelpers.hpp>
+
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "assembly.hpp"
@@ -161,6 +164,57 @@ TEST(SteadyStick, SaddlePointStepMovesStickTractions) {
 }
 
 // Analysis/Type = Steady Rolling needs an annulus about its own axis on a
+
+// The step predictor's K z (the kernels' products, the cores' rows summed from
+// their face nodes) against the assembled matrix on every free row, the core's
+// included, with omega free and with it held at the start's value (its row
+// omega - held = 0, whose K z is then 0, not the torque balance's).
+TEST(SteadyCore, PredictorLoadMatchesMatrixOnTheCoreRows) {
+  const Scene scene = steadyScene({});
+  const auto& m = scene.mesh;
+  AnnulusGenerator gen(m.center, m.innerRadius, m.outerRadius, m.length, m.cells, m.outerCellRatio, m.fineSector);
+  Mesh mesh = distributeMesh(gen, Tpetra::getDefaultComm(), Partition::Metis, {"outer"});
+  Assembly assembly(mesh, scene);
+  const auto map = assembly.dofMap();
+  Vector u(map), z(map), Kz(map), Wz(map), f(map);
+  fill(assembly, mesh, u, 0.02, 0.0, -0.23);
+  assembly.setInterval(0.0, 0.5);
+  assembly.applyConstraints(u, 0.5);
+  fill(assembly, mesh, z, 1.0, 0.4, 0.0);
+  {
+    auto d = z.getDataNonConst();
+    for (LO i = 0; i < LO(d.size()); ++i)
+      if (assembly.ownedConstrained(i)) d[i] = 0;
+    for (int j = 0; j < 6; ++j)  // node dofs only, as the predictor's z on a free core
+      if (assembly.ownedCoreDof(0, j) >= 0) d[assembly.ownedCoreDof(0, j)] = 0;
+  }
+  for (const bool hold : {false, true}) {
+    assembly.cores().holdAngularVelocity(0, hold ? -0.25 : std::numeric_limits<double>::quiet_NaN());
+    auto W = assembly.createMatrix();
+    ASSERT_TRUE(assembly.evaluate(u, &f, W.get(), &z, &Kz));
+    W->apply(z, Wz);
+    const double scale = Wz.normInf();
+    Vector diff(map);
+    diff.update(1.0, Kz, -1.0, Wz, 0.0);
+    {
+      auto d = diff.getDataNonConst();
+      for (LO i = 0; i < LO(d.size()); ++i)
+        if (assembly.ownedConstrained(i)) d[i] = 0;
+    }
+    // The torque row's own entry, where this rank owns it.
+    double torqueRow = 0, torqueRowAll = 0;
+    if (assembly.ownedCoreDof(0, 3) >= 0) torqueRow = std::fabs(Wz.getData()[assembly.ownedCoreDof(0, 3)]);
+    Teuchos::reduceAll(*mesh.comm, Teuchos::REDUCE_MAX, torqueRow, Teuchos::outArg(torqueRowAll));
+    std::printf("omega %s: max |K z - W z| / max |W z| = %.2e, |W z| on the torque row %.2e\n",
+                hold ? "held" : "free", diff.normInf() / scale, torqueRowAll);
+    EXPECT_LT(diff.normInf(), 1e-12 * scale) << (hold ? "held" : "free");
+    if (hold) {
+      EXPECT_EQ(torqueRowAll, 0.0) << "the held row: omega - held";
+    } else {
+      EXPECT_GT(torqueRowAll, 1e-6 * scale) << "the torque balance sees the face nodes";
+    }
+  }
+}
 // Rigid Core or Fixed inner face, and capstans parallel to it that stay put.
 TEST(SteadyScene, RejectsWhatItCannotSolve) {
   auto fails = [](const std::vector<std::string>& sets, const std::string& path) {
