@@ -107,6 +107,7 @@ double triadBandwidth(long n, double seconds) {
 int main(int argc, char** argv) {
   capstan::reexecWithHeapTunables(argv);  // as capstan itself runs (src/heap_tunables.hpp)
   Tpetra::ScopeGuard scope(&argc, &argv);
+  if (capstan::launchedByMpiexec()) capstan::setTcpNoDelay();  // finalize without 40 ms stalls (src/mpi_startup.hpp)
   const int n = argc > 1 ? std::atoi(argv[1]) : 20;
   auto comm = Tpetra::getDefaultComm();
   const double peak = fmaPeak();

@@ -97,6 +97,7 @@ int main(int argc, char** argv) {
   }
   capstan::reexecWithHeapTunables(argv);  // before MPI starts (src/heap_tunables.hpp)
   Tpetra::ScopeGuard tpetra(&argc, &argv);
+  if (capstan::launchedByMpiexec()) capstan::setTcpNoDelay();  // finalize without 40 ms stalls (src/mpi_startup.hpp)
   auto comm = Tpetra::getDefaultComm();
   const bool rank0 = comm->getRank() == 0;
   Args args;

@@ -233,3 +233,34 @@ TEST(MpiStartup, DefaultsKeepTheUsersSettings) {
   savedPml.empty() ? unsetenv("OMPI_MCA_pml") : setenv("OMPI_MCA_pml", savedPml.c_str(), 1);
   savedMtl.empty() ? unsetenv("OMPI_MCA_mtl") : setenv("OMPI_MCA_mtl", savedMtl.c_str(), 1);
 }
+
+// setTcpNoDelay (src/mpi_startup.hpp): a loopback TCP connection sends at once
+// afterwards, at both ends; a Unix socket pair is left as it was.
+TEST(MpiStartup, TcpSocketsSendAtOnce) {
+  const int listener = socket(AF_INET, SOCK_STREAM, 0);
+  ASSERT_GE(listener, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t size = sizeof address;
+  ASSERT_EQ(bind(listener, reinterpret_cast<sockaddr*>(&address), size), 0);
+  ASSERT_EQ(listen(listener, 1), 0);
+  ASSERT_EQ(getsockname(listener, reinterpret_cast<sockaddr*>(&address), &size), 0);
+  const int client = socket(AF_INET, SOCK_STREAM, 0);
+  ASSERT_EQ(connect(client, reinterpret_cast<sockaddr*>(&address), size), 0);
+  const int server = accept(listener, nullptr, nullptr);
+  ASSERT_GE(server, 0);
+  int pair[2];
+  ASSERT_EQ(socketpair(AF_UNIX, SOCK_STREAM, 0, pair), 0);
+  auto noDelay = [](int fd) {
+    int on = -1;
+    socklen_t length = sizeof on;
+    return getsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &on, &length) == 0 ? on : -1;
+  };
+  EXPECT_EQ(noDelay(client), 0);  // Nagle's algorithm on, as the kernel opens it
+  EXPECT_GE(setTcpNoDelay(), 3);   // the listener, both ends, and any MPI holds
+  EXPECT_NE(noDelay(client), 0);
+  EXPECT_NE(noDelay(server), 0);
+  EXPECT_EQ(noDelay(pair[0]), -1);  // not a TCP socket: untouched
+  for (int fd : {client, server, listener, pair[0], pair[1]}) close(fd);
+}
