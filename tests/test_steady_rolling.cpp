@@ -49,6 +49,14 @@ void fill(const Assembly& a, const Mesh& mesh, Vector& v, double scale, double p
   }
 }
 
+// fill() with the held dofs left at zero: a direction the constraints allow.
+void fillFree(const Assembly& a, const Mesh& mesh, Vector& v, double scale, double phase, double omega) {
+  fill(a, mesh, v, scale, phase, omega);
+  auto d = v.getDataNonConst();
+  for (LO i = 0; i < LO(d.size()); ++i)
+    if (a.ownedConstrained(i)) d[i] = 0;
+}
+
 struct Case {
   const char* name;
   std::vector<std::string> sets;
@@ -91,12 +99,7 @@ TEST_P(SteadyTangent, MatchesCentralDifferences) {
   fill(assembly, mesh, u, 0.02, 0.0, -0.23);
   assembly.setInterval(0.0, 0.5);
   assembly.applyConstraints(u, 0.5);
-  fill(assembly, mesh, v, 1.0, 0.4, 0.7);
-  {
-    auto d = v.getDataNonConst();
-    for (LO i = 0; i < LO(d.size()); ++i)
-      if (assembly.ownedConstrained(i)) d[i] = 0;
-  }
+  fillFree(assembly, mesh, v, 1.0, 0.4, 0.7);
   double scale = 0;
   const double err = tangentError(assembly, u, v, scale);
   const auto ff = assembly.frictions()[0]->figures();
@@ -180,14 +183,9 @@ TEST(SteadyCore, PredictorLoadMatchesMatrixOnTheCoreRows) {
   fill(assembly, mesh, u, 0.02, 0.0, -0.23);
   assembly.setInterval(0.0, 0.5);
   assembly.applyConstraints(u, 0.5);
-  fill(assembly, mesh, z, 1.0, 0.4, 0.0);
-  {
-    auto d = z.getDataNonConst();
-    for (LO i = 0; i < LO(d.size()); ++i)
-      if (assembly.ownedConstrained(i)) d[i] = 0;
-    for (int j = 0; j < 6; ++j)  // node dofs only, as the predictor's z on a free core
-      if (assembly.ownedCoreDof(0, j) >= 0) d[assembly.ownedCoreDof(0, j)] = 0;
-  }
+  fillFree(assembly, mesh, z, 1.0, 0.4, 0.0);
+  for (int j = 0; j < 6; ++j)  // node dofs only, as the predictor's z on a free core
+    if (assembly.ownedCoreDof(0, j) >= 0) z.getDataNonConst()[assembly.ownedCoreDof(0, j)] = 0;
   for (const bool hold : {false, true}) {
     assembly.cores().holdAngularVelocity(0, hold ? -0.25 : std::numeric_limits<double>::quiet_NaN());
     auto W = assembly.createMatrix();
