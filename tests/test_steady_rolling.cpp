@@ -166,8 +166,6 @@ TEST(SteadyStick, SaddlePointStepMovesStickTractions) {
   }
 }
 
-// Analysis/Type = Steady Rolling needs an annulus about its own axis on a
-
 // The step predictor's K z (the kernels' products, the cores' rows summed from
 // their face nodes) against the assembled matrix on every free row, the core's
 // included, with omega free and with it held at the start's value (its row
@@ -213,6 +211,8 @@ TEST(SteadyCore, PredictorLoadMatchesMatrixOnTheCoreRows) {
     }
   }
 }
+
+// Analysis/Type = Steady Rolling needs an annulus about its own axis on a
 // Rigid Core or Fixed inner face, and capstans parallel to it that stay put.
 TEST(SteadyScene, RejectsWhatItCannotSolve) {
   auto fails = [](const std::vector<std::string>& sets, const std::string& path) {
