@@ -30,16 +30,15 @@
 
 #include <netinet/in.h>
 #include <netinet/tcp.h>
-#include <sys/resource.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include <algorithm>
 #include <cerrno>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace capstan {
 
@@ -76,10 +75,12 @@ inline void setMpiStartupDefaults() {
 // After MPI_Init: TCP_NODELAY on every TCP socket this process holds (see
 // above); returns how many. Sockets of other kinds and other files are left.
 inline int setTcpNoDelay() {
-  rlimit limit{};
-  const long open = getrlimit(RLIMIT_NOFILE, &limit) == 0 ? long(std::min<rlim_t>(limit.rlim_cur, 4096)) : 1024;
+  std::vector<int> open;  // the descriptors (listed first: the listing opens one itself)
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator("/proc/self/fd", ec))
+    open.push_back(std::atoi(entry.path().filename().c_str()));
   int count = 0;
-  for (int fd = 0; fd < open; ++fd) {
+  for (int fd : open) {
     int type = 0;
     socklen_t length = sizeof type;
     if (getsockopt(fd, SOL_SOCKET, SO_TYPE, &type, &length) != 0 || type != SOCK_STREAM) continue;
