@@ -113,11 +113,7 @@ std::vector<std::array<double, 5>> RigidCores::sums(const double* v) const {
 std::vector<std::array<double, 4>> RigidCores::rowSums(const double* v) const {
   const auto s = sums(v);
   std::vector<std::array<double, 4>> out(s.size());
-  for (size_t c = 0; c < s.size(); ++c) {
-    // A held omega's row is omega - held, which no node moves.
-    const double torqueRow = cores_[c].holding() ? 0.0 : s[c][3] / cores_[c].radius;
-    out[c] = {s[c][0], s[c][1], s[c][2], torqueRow};
-  }
+  for (size_t c = 0; c < s.size(); ++c) out[c] = {s[c][0], s[c][1], s[c][2], cores_[c].torqueRow(s[c][3])};
   return out;
 }
 
@@ -240,7 +236,7 @@ void RigidCores::assembleCoupling(FEMatrix& W, const std::vector<std::unique_ptr
       if (freeCoreDof(p) && v != 0) cols.push_back(columnOf[coreDof(p)]), vals.push_back(v);
     }
     if (q % 4 == 3)  // the torque balance as the residual writes it: over the core's radius
-      for (double& v : vals) v /= cores_[q / 4].radius;
+      for (double& v : vals) v = cores_[q / 4].torqueRow(v);
     if (!cols.empty()) add(layout_.overlapLid(coreDof(q)));
   }
 }

@@ -43,6 +43,9 @@ struct RigidCore {
   // row (omega - heldAngularVelocity = 0) while free, where NaN: not held.
   double heldAngularVelocity = std::numeric_limits<double>::quiet_NaN();
   bool holding() const { return !std::isnan(heldAngularVelocity); }
+  // A torque as the core's torque row holds it: over the radius (below), and nothing
+  // while omega is held (the row is then omega - held).
+  double torqueRow(double torque) const { return holding() ? 0.0 : torque / radius; }
   std::array<double, 3> forceOnBody{};
   double torqueOnBody = 0;
   double geometric = 0;  // sum over the face's nodes of R . w (the theta-theta tangent term)
@@ -115,7 +118,7 @@ class RigidCores {
     const int j = (dof - layout_.nodeDofs) % 6;
     if (j == 3 && core.holding()) return core.angularVelocity - core.heldAngularVelocity;
     return j < 3 ? core.forceOnBody[j] - core.loadFactor(t) * core.force[j]
-                 : (core.torqueOnBody - core.torqueFactor(t) * core.torque) / core.radius;
+                 : core.torqueRow(core.torqueOnBody - core.torqueFactor(t) * core.torque);
   }
 
   // The matrix graph. findCoupling: each stiff effect's entities with a face
@@ -155,9 +158,8 @@ class RigidCores {
     const auto B = chain(dof);
     for (int q = 0; q < 3; ++q)
       if (core.free[q] && q == dof % 3) f(core.firstDof + q, B[q]);
-    if (core.free[3] && !core.holding()) f(core.firstDof + 3, B[3] / core.radius);
+    if (core.free[3] && !core.holding()) f(core.firstDof + 3, core.torqueRow(B[3]));
   }
-
 
   // The chain rule at the cores' face nodes: the kept element-matrix entries
   // that touch a face node (sinks[i].kept for effect i), carried to the cores'
