@@ -22,7 +22,7 @@ namespace capstan::checkpoint {
 
 namespace fs = std::filesystem;
 
-inline const char* kMagic = "capstan checkpoint 7";
+inline const char* kMagic = "capstan checkpoint 8";
 
 inline unsigned long long fnv1a(const char* p, size_t n) {
   unsigned long long h = 14695981039346656037ull;

@@ -538,8 +538,11 @@ void MumpsSolver::analyse(const CrsMatrix& A) {
   }
   analysed_ = true;
   ++numAnalyses_;
+  ++processCounts_.analyses;
   analysisSeconds_ = MPI_Wtime() - t0;
 }
+
+MumpsSolver::Counts MumpsSolver::processCounts_;
 
 double MumpsSolver::analyseWith(MumpsOptions::Ordering ordering) {
   Impl& m = *impl_;
@@ -644,6 +647,7 @@ void MumpsSolver::runFactorization() {
   call(0, "factorisation");  // checks the result
   factored_ = true;
   ++numFactorizations_;
+  ++processCounts_.factorizations;
 }
 
 // Runs JOB = job (0: only checks the last call's result) and throws on error.
@@ -665,6 +669,7 @@ void MumpsSolver::solve(const MultiVector& b, MultiVector& x) {
   if (anyRank(bad, m.comm) || !b.getMap()->isSameAs(*m.rowMap) || !x.getMap()->isSameAs(*m.rowMap))
     throw std::invalid_argument("MumpsSolver::solve: b and x must be on the matrix' row map, alike in columns");
   if (nrhs == 0) return;
+  processCounts_.solves += long(nrhs);
 
   const std::size_t n = m.nGlobal;
   if (m.rank == 0) m.rhs.assign(n * nrhs, 0.0);

@@ -96,6 +96,12 @@ class MumpsSolver {
 
   // Counters (since construction).
   int numAnalyses() const { return numAnalyses_; }
+  // Every instance's together, over the process (summary.json's timing.direct_solver): analyses
+  // (as numAnalyses), factorisations, and right-hand sides solved.
+  struct Counts {
+    long analyses = 0, factorizations = 0, solves = 0;
+  };
+  static Counts processCounts() { return processCounts_; }
   // MUMPS analyses run: Ordering = Auto runs two or three for one analysis.
   int numOrderingAnalyses() const { return numOrderingAnalyses_; }
   int numFactorizations() const { return numFactorizations_; }
@@ -141,6 +147,7 @@ class MumpsSolver {
   MumpsOptions::Ordering autoWinner_ = MumpsOptions::Ordering::Auto;
   double autoWinnerEntries_ = 0;
   double analysisSeconds_ = 0, factorSeconds_ = 0, solveSeconds_ = 0;
+  static Counts processCounts_;
 };
 
 }  // namespace capstan

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "collective.hpp"
+#include "direct_solver.hpp"
 #include "errors.hpp"
 #include "json.hpp"
 #include "step_figures.hpp"
@@ -273,6 +274,10 @@ Timings Outputs::timings() const {
   t.linearSolve = m_.linearSolveSeconds() + earlier.linearSolve;
   t.output = outputSeconds_ + earlier.output;
   t.preconditionerSetup = m_.newton->preconditionerSeconds() + earlier.preconditionerSetup;
+  const auto direct = MumpsSolver::processCounts();
+  t.directAnalyses = direct.analyses + earlier.directAnalyses;
+  t.directFactorizations = direct.factorizations + earlier.directFactorizations;
+  t.directSolves = direct.solves + earlier.directSolves;
   for (const auto& e : m_.effects()) {
     Timings::Effect sum{e->name(), e->launches(), e->seconds()};
     for (const auto& before : earlier.effects)
@@ -316,7 +321,12 @@ void Outputs::writeSummary(const std::vector<StepRecord>& steps, const std::vect
       .add("assembly", json::number(t.assembly))
       .add("linear_solve", json::number(t.linearSolve))
       .add("output", json::number(t.output))
-      .add("preconditioner_setup", json::number(t.preconditionerSetup));
+      .add("preconditioner_setup", json::number(t.preconditionerSetup))
+      .add("direct_solver", Object()
+                                .add("analyses", json::number(t.directAnalyses))
+                                .add("factorizations", json::number(t.directFactorizations))
+                                .add("solves", json::number(t.directSolves))
+                                .str());
   Object memory;
   memory.add("peak_rss_mib", json::array(peakMiB))
       .add("peak_rss_mib_max", json::number(*std::max_element(peakMiB.begin(), peakMiB.end())))

@@ -23,6 +23,7 @@ namespace capstan {
 // kernel launches and seconds (in the assembly's effect order).
 struct Timings {
   double total = 0, assembly = 0, linearSolve = 0, output = 0, preconditionerSetup = 0;
+  long directAnalyses = 0, directFactorizations = 0, directSolves = 0;  // MumpsSolver::processCounts
   struct Effect {
     std::string name;
     long launches = 0;

@@ -75,6 +75,7 @@ std::string checkpointBytes(const Model& model, const Timings& timings, const st
     for (const auto& r : steps) checkpoint::put(w, r);
     w.put(timings.total), w.put(timings.assembly), w.put(timings.linearSolve), w.put(timings.output);
     w.put(timings.preconditionerSetup);
+    w.put(timings.directAnalyses), w.put(timings.directFactorizations), w.put(timings.directSolves);
     for (const auto& e : timings.effects) w.put<long>(e.launches), w.put<double>(e.seconds);
     w.put<int>(int(switches.size()));
     for (const auto& s : switches) w.put<int>(s.step), w.put(s.what);
@@ -333,6 +334,8 @@ void Restart::restore(Model& model, std::vector<StepRecord>& steps, std::vector<
       earlier.total = in.get<double>(), earlier.assembly = in.get<double>();
       earlier.linearSolve = in.get<double>(), earlier.output = in.get<double>();
       earlier.preconditionerSetup = in.get<double>();
+      earlier.directAnalyses = in.get<long>(), earlier.directFactorizations = in.get<long>();
+      earlier.directSolves = in.get<long>();
       for (const auto& e : effects) {
         Timings::Effect t{e->name()};
         t.launches = in.get<long>();

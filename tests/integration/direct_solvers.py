@@ -13,6 +13,9 @@ Solver/Stratimikos/Linear Solver Type = Amesos2) and with MUMPS on 1 and 2 ranks
   * the final stress, pressure and von Mises extrema, the face means of the displacement
     and every support and capstan force of every step agree to 1e-10 relative to the
     largest magnitude of their kind, and the cores' rotations to 1e-10 of the largest.
+summary.json's timing.direct_solver counts MUMPS' work: at least one analysis, a factorisation
+for each Newton iteration at least (Direct factors every Newton matrix), a solve for each
+factorisation at least, and the same factorisations and solves on 1 and 2 ranks.
 Both solvers run the saddle-point steps on a factorisation of their own
 (Solver/Pressure Step Factorisation = New): with MUMPS the default reuses Newton's last
 one, which KLU2 cannot, and takes the slice along another path within Newton's tolerance
@@ -60,6 +63,7 @@ for name, scene, sets in (("g1", "seed/g1.xml", []), ("h5", "seed/h5.xml", []),
         continue
     newton_ref = [st["newton_iterations"] for st in ref["steps"]]
     route_ref = [(st["cutbacks"], st["augmentations"]) for st in ref["steps"]]
+    work = {}  # ranks: MUMPS' (factorisations, solves)
     for ranks in (1, 2):
         _, s, out = T.run_scene(path, f"{name}-mumps-{ranks}", sets=sets, ranks=ranks)
         label = f"{name}, MUMPS on {ranks} rank(s)"
@@ -69,6 +73,11 @@ for name, scene, sets in (("g1", "seed/g1.xml", []), ("h5", "seed/h5.xml", []),
         T.check(s["converged"] is True, f"{label}: converged = {s['converged']} ({s['failure']!r})")
         T.conforms(out, path)
         newton = [st["newton_iterations"] for st in s["steps"]]
+        d = s["timing"]["direct_solver"]
+        T.check(d["analyses"] >= 1 and d["factorizations"] >= sum(newton) and d["solves"] >= d["factorizations"],
+                f"{label}: timing.direct_solver {d}: an analysis, a factorisation a Newton iteration "
+                f"({sum(newton)}) and a solve a factorisation at least")
+        work[ranks] = (d["factorizations"], d["solves"])
         route = [(st["cutbacks"], st["augmentations"]) for st in s["steps"]]
         T.check(route == route_ref, f"{label}: (cuts, augmentations) per step {route} as KLU2's {route_ref}")
         same = all(n == m or (c > 0 and abs(n - m) <= 0.2 * m)
@@ -83,5 +92,7 @@ for name, scene, sets in (("g1", "seed/g1.xml", []), ("h5", "seed/h5.xml", []),
                 continue
             worst, k, scale = worst_difference(figures, other[group])
             T.check(worst <= TOL, f"{label}: {group} as KLU2's: worst {worst:.2e} ({k}) (<= {TOL:g})")
+    if len(work) == 2:
+        T.check(work[1] == work[2], f"{name}: MUMPS' (factorisations, solves) {work[2]} on 2 ranks as on 1 {work[1]}")
 
 T.finish()

@@ -247,6 +247,11 @@ def compare(tag, ref_out, out, scene=None):
             f"{tag}: all {len(a)} per-step figures of summary.json agree (largest relative difference "
             f"{worst:.1e}; differing: {bad[:4]})")
     T.conforms(out, scene or SCENE)
+    # The checkpoint carries the direct solver's counts so far: with the same arithmetic, the
+    # same factorisations and solves (a new process analyses the pattern again).
+    wa, wb = ref["timing"]["direct_solver"], got["timing"]["direct_solver"]
+    T.check((wa["factorizations"], wa["solves"]) == (wb["factorizations"], wb["solves"]),
+            f"{tag}: timing.direct_solver {wb}: the uninterrupted run's factorisations and solves {wa}")
 
     def rows(d):
         with open(os.path.join(d, "history.csv")) as f:
