@@ -249,6 +249,8 @@ struct MumpsSolver::Impl {
   std::vector<double> rhs;        // rank 0: the centralised right-hand sides
 };
 
+MumpsSolver::Counts MumpsSolver::processCounts_;
+
 MumpsSolver::MumpsSolver(const MumpsOptions& options) : options_(options) {}
 
 MumpsSolver::~MumpsSolver() {
@@ -541,8 +543,6 @@ void MumpsSolver::analyse(const CrsMatrix& A) {
   ++processCounts_.analyses;
   analysisSeconds_ = MPI_Wtime() - t0;
 }
-
-MumpsSolver::Counts MumpsSolver::processCounts_;
 
 double MumpsSolver::analyseWith(MumpsOptions::Ordering ordering) {
   Impl& m = *impl_;

@@ -96,16 +96,16 @@ class MumpsSolver {
 
   // Counters (since construction).
   int numAnalyses() const { return numAnalyses_; }
+  // MUMPS analyses run: Ordering = Auto runs two or three for one analysis.
+  int numOrderingAnalyses() const { return numOrderingAnalyses_; }
+  int numFactorizations() const { return numFactorizations_; }
+  int numWorkspaceRetries() const { return numWorkspaceRetries_; }  // -8/-9 retries
   // Every instance's together, over the process (summary.json's timing.direct_solver): analyses
   // (as numAnalyses), factorisations, and right-hand sides solved.
   struct Counts {
     long analyses = 0, factorizations = 0, solves = 0;
   };
   static Counts processCounts() { return processCounts_; }
-  // MUMPS analyses run: Ordering = Auto runs two or three for one analysis.
-  int numOrderingAnalyses() const { return numOrderingAnalyses_; }
-  int numFactorizations() const { return numFactorizations_; }
-  int numWorkspaceRetries() const { return numWorkspaceRetries_; }  // -8/-9 retries
 
   // The last factorisation's size and memory: entries in the factors (INFOG(29),
   // all ranks) and MB used during the factorisation (INFOG(21): the largest on
