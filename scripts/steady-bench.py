@@ -31,6 +31,9 @@ def describe(label, rc, wall, s):
     ratios = [st["supports"]["core"].get("speed_ratio", float("nan")) for st in steps]
     print(f"{label}: exit {rc}, {wall:.1f} s wall, {len(steps)} steps, cuts {cuts}")
     print(f"    Newton per step: {newton}")
+    d = s["timing"].get("direct_solver")
+    if d:
+        print(f"    MUMPS: {d['analyses']} analyses, {d['factorizations']} factorisations, {d['solves']} solves")
     print("    speed ratio: " + ", ".join(f"{r:.5f}" for r in ratios))
     if len(ratios) > 2:
         half = ratios[len(ratios) // 2:]
