@@ -36,6 +36,10 @@ class NewtonSolver {
   // Solves R(u) = 0 from the initial guess u (updated in place) until
   // |R| <= tolerance.
   NewtonResult solve(Vector& u, double tolerance);
+  // While on, a solve fails once |R| has fallen by less than a tenth over its last 8 iterations
+  // (a stall): for solves whose failure has a cheaper way on, as steady rolling's start
+  // (docs/steady-rolling.md, "The stall test"). Off by default.
+  void failOnStall(bool on);
   // Pseudo-transient continuation (Kelley and Keyes 1998) to |R| <= tolerance: Newton with
   // |diag W| / dtau on the diagonal. Small dtau follows the force across rising |R| and indefinite
   // tangents, where the line search stalls; a failed solve's fallback. stepLengths: dtau.
