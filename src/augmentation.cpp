@@ -270,7 +270,7 @@ NewtonResult AugmentationLoop::solvePositions(double t, const Pass& pass, bool a
     // there (solve()). The steady drive under Tanh, eps3 = 1e-4, ran the whole
     // continuation after one (11 stages, about 130 Newton iterations, and it
     // failed), where the undone step's plain pass converged in 1.
-    if (!r.converged && continuation_.canRetry() && !afterStep) {
+    if (!r.converged && continuation_.canRetry() && (cornerRetry_ || continuation_.regularised()) && !afterStep) {
       if (log_.on("newton"))
         log_.event("newton", continuation_.regularised()
                                  ? format("newton failed (%s) in %d iterations: continuation in the friction "

@@ -56,6 +56,10 @@ class AugmentationLoop {
   // stick (LoadStepper: in sub-steps cut a few times; otherwise only where
   // every point slips, see solvePositions).
   void allowPseudoTimeWithStick(bool allow) { pseudoTimeWithStick_ = allow; }
+  // Coulomb: whether a failed Newton solve is tried again through a smoothed stick/slip corner
+  // (RegularisationContinuation); off where the caller's own retry does better (steady
+  // rolling's start: SteadyRolling::startFromRest).
+  void allowCornerRetry(bool allow) { cornerRetry_ = allow; }
 
  private:
   // solve() once, with the step's preconditioner as it stands.
@@ -135,6 +139,7 @@ class AugmentationLoop {
   std::vector<Kokkos::View<double*>> pressureStepDmu_;  // per effect: its multipliers' change in the step
   bool lastStepShortened_ = false;                     // the last saddle-point step was halved
   bool pseudoTimeWithStick_ = false;                   // allowPseudoTimeWithStick
+  bool cornerRetry_ = true;                            // allowCornerRetry
 };
 
 }  // namespace capstan

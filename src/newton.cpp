@@ -245,7 +245,7 @@ class Crawl : public NOX::StatusTest::Generic {
 // iterations, whatever its steps: a solve that will end at the iteration limit or in a failed line
 // search, up to 48 iterations later, where the caller has a cheaper way on. Over the 34 steady
 // scenes of `scripts/steady-start-scales.py --hard` 12 of the 17 start solves that failed had
-// stalled so, and none that converged had (docs/steady-rolling.md, "The stall test").
+// stalled so, and none that converged had (docs/steady-rolling.md, "Failed tries in the start").
 class Stall : public NOX::StatusTest::Generic {
  public:
   NOX::StatusTest::StatusType checkStatus(const NOX::Solver::Generic& s, NOX::StatusTest::CheckType) override {

@@ -38,7 +38,7 @@ class NewtonSolver {
   NewtonResult solve(Vector& u, double tolerance);
   // While on, a solve fails once |R| has fallen by less than a tenth over its last 8 iterations
   // (a stall): for solves whose failure has a cheaper way on, as steady rolling's start
-  // (docs/steady-rolling.md, "The stall test"). Off by default.
+  // (docs/steady-rolling.md, "Failed tries in the start"). Off by default.
   void failOnStall(bool on);
   // Pseudo-transient continuation (Kelley and Keyes 1998) to |R| <= tolerance: Newton with
   // |diag W| / dtau on the diagonal. Small dtau follows the force across rising |R| and indefinite

@@ -33,11 +33,11 @@ first order); a free core's translation too (2e-4 in steady rolling).
     the retry with a stick 10x the automatic one converges and the scene's stick holds from
     there (77 Newton iterations); against the shipped scene;
   * the steady 3D drive with a very stiff stick (Tangential Penalty = 1e-6, 1/3400 of the
-    automatic value): its first steady-state solve stalls (|R| 0.12-0.13 from its 10th
-    iteration on) and fails on the stall test after 11 iterations, not at the iteration limit
-    (59: NewtonSolver::failOnStall, SteadyRolling::startFromRest); the retry with a softer
-    stick converges; 65 Newton iterations (154 before the stall test), within 100; against
-    the shipped scene;
+    automatic value): its first steady-state solve stalls and fails on the stall test after
+    18 iterations (NewtonSolver::failOnStall; before, it ran on to the iteration limit, 60,
+    and a retry through a smoothed stick/slip corner did again, 59), and the retry with a 10x softer stick converges (SteadyRolling::
+    startFromRest, "Failed tries in the start" in docs/steady-rolling.md); 53 Newton
+    iterations (154 before), within 100; against the shipped scene;
   * the steady 3D drive under Tanh with Regularization = 1e-4 (a slip speed scale 2e-6 of
     the capstan's surface speed): its start from rest goes through its own law at wider
     scales (SteadyRolling::startThroughWideLaws; 453 Newton iterations before, through
@@ -45,9 +45,9 @@ first order); a free core's translation too (2e-4 in steady rolling).
     shipped scene);
   * the steady 3D drive pressed 8x harder (32 N, ramped in 1e-6 s of its one 1e-3 s step):
     the start from rest's second Tanh stage fails at the full force and is tried again
-    through a stage halfway to it (SteadyRolling::startThroughWideLaws; 155 Newton
-    iterations within 200, of which the stall test saves 67: 222 before it, 868 and 3 cuts
-    before the halfway stage), against the force ramped over two steps,
+    through a stage halfway to it (SteadyRolling::startThroughWideLaws; 131 Newton
+    iterations within 200: 222 before the start's quicker failures, 868 and 3 cuts before
+    the halfway stage), against the force ramped over two steps,
     whose second step goes through the wider laws again (SteadyRolling::solve).
 
 Then the steady 3D drive with a fine nip over thick outer cells (3x120x8, 0.28-degree nip
