@@ -252,8 +252,8 @@ class Stall : public NOX::StatusTest::Generic {
     if (s.getNumIterations() == 0) norms_.clear();
     norms_.push_back(s.getSolutionGroup().getNormF());
     const size_t k = norms_.size() - 1, w = size_t(kStallWindow);
-    status_ = on && k >= w && norms_[k] > kStallFactor * norms_[k - w] ? NOX::StatusTest::Failed
-                                                                         : NOX::StatusTest::Unconverged;
+    status_ = k >= w && norms_[k] > kStallFactor * norms_[k - w] ? NOX::StatusTest::Failed
+                                                                   : NOX::StatusTest::Unconverged;
     return status_;
   }
   NOX::StatusTest::StatusType getStatus() const override { return status_; }
@@ -262,7 +262,6 @@ class Stall : public NOX::StatusTest::Generic {
   }
   static constexpr int kStallWindow = 8;
   static constexpr double kStallFactor = 0.9;
-  bool on = false;
 
  private:
   std::vector<double> norms_;
@@ -638,14 +637,13 @@ NewtonResult NewtonSolver::solve(Vector& u, double tolerance) {
   auto stagnation = rcp(new NOX::StatusTest::Stagnation(5, 0.999));
   auto crawl = rcp(new Crawl(impl_->solver.crawlIterations));
   auto stall = rcp(new Stall);
-  stall->on = impl_->failOnStall;
   auto tests = rcp(new NOX::StatusTest::Combo(NOX::StatusTest::Combo::OR));
   tests->addStatusTest(finite);
   tests->addStatusTest(normF);
   tests->addStatusTest(maxIters);
   tests->addStatusTest(stagnation);
   tests->addStatusTest(crawl);
-  tests->addStatusTest(stall);
+  if (impl_->failOnStall) tests->addStatusTest(stall);
 
   NewtonResult r;
   NOX::StatusTest::StatusType status = NOX::StatusTest::Failed;
