@@ -241,29 +241,26 @@ class Crawl : public NOX::StatusTest::Generic {
   NOX::StatusTest::StatusType status_ = NOX::StatusTest::Unconverged;
 };
 
-// Fails a solve whose |R| fell by less than 1 - kStallFactor over its last kStallWindow
-// iterations, whatever its steps: a solve that will end at the iteration limit or in a failed line
-// search, up to 48 iterations later, where the caller has a cheaper way on. Over the 34 steady
-// scenes of `scripts/steady-start-scales.py --hard` 12 of the 17 start solves that failed had
-// stalled so, and none that converged had (docs/steady-rolling.md, "Failed tries in the start").
+// Fails a solve whose |R| fell by less than 1 - factor over its last `window` iterations,
+// whatever its steps (NewtonSolver::failOnStall).
 class Stall : public NOX::StatusTest::Generic {
  public:
+  explicit Stall(StallRule rule) : rule_(rule) {}
   NOX::StatusTest::StatusType checkStatus(const NOX::Solver::Generic& s, NOX::StatusTest::CheckType) override {
     if (s.getNumIterations() == 0) norms_.clear();
     norms_.push_back(s.getSolutionGroup().getNormF());
-    const size_t k = norms_.size() - 1, w = size_t(kStallWindow);
-    status_ = k >= w && norms_[k] > kStallFactor * norms_[k - w] ? NOX::StatusTest::Failed
-                                                                   : NOX::StatusTest::Unconverged;
+    const size_t k = norms_.size() - 1, w = size_t(rule_.window);
+    status_ = k >= w && norms_[k] > rule_.factor * norms_[k - w] ? NOX::StatusTest::Failed
+                                                                  : NOX::StatusTest::Unconverged;
     return status_;
   }
   NOX::StatusTest::StatusType getStatus() const override { return status_; }
   std::ostream& print(std::ostream& o, int indent = 0) const override {
-    return o << std::string(indent, ' ') << status_ << "Stall (|R| over " << kStallWindow << " iterations)\n";
+    return o << std::string(indent, ' ') << status_ << "Stall (|R| over " << rule_.window << " iterations)\n";
   }
-  static constexpr int kStallWindow = 8;
-  static constexpr double kStallFactor = 0.9;
 
  private:
+  StallRule rule_;
   std::vector<double> norms_;
   NOX::StatusTest::StatusType status_ = NOX::StatusTest::Unconverged;
 };
@@ -286,7 +283,7 @@ struct NewtonSolver::Impl {
   double preconditionerSeconds = 0;  // part of linearSeconds
   // A solver's exception on one rank alone, made every rank's (or the job's end).
   FailureAgreement agreement;
-  bool failOnStall = false;
+  StallRule stall;  // off: window 0
   Impl(Assembly& a, const SolverSettings& s) : assembly(a), solver(s), agreement(a.dofMap()->getComm()) {}
 
   RCP<Teuchos::ParameterList> noxParameters(const RCP<NOX::Observer>& observer) const {
@@ -599,8 +596,10 @@ NewtonResult NewtonSolver::pseudoTransient(Vector& u, double tolerance) {
     r.stepLengths.push_back(dtau);
     // A step that turns back on the last one overshot (the tangent's model
     // switches across a kink, e.g. stick and slip): a shorter pseudo-time step.
+    // Otherwise dtau grows as |R| falls (switched evolution relaxation), at least doubling: where
+    // the force is balanced fast the steps become Newton's sooner (docs/friction.md, "What step 2 is").
     const bool reversed = hasPrevious && dx.dot(previous) < -0.5 * dx.norm2() * previous.norm2();
-    dtau *= trialNorm <= 1.5 * norm && !reversed ? 2.0 : 0.5;
+    dtau *= trialNorm <= 1.5 * norm && !reversed ? std::max(2.0, norm / trialNorm) : 0.5;
     previous.update(1.0, dx, 0.0);
     hasPrevious = true;
     u.update(1.0, trial, 0.0);
@@ -617,7 +616,7 @@ NewtonResult NewtonSolver::pseudoTransient(Vector& u, double tolerance) {
   return r;
 }
 
-void NewtonSolver::failOnStall(bool on) { impl_->failOnStall = on; }
+void NewtonSolver::failOnStall(StallRule rule) { impl_->stall = rule; }
 
 NewtonResult NewtonSolver::solve(Vector& u, double tolerance) {
   Kokkos::Timer timer;
@@ -636,14 +635,14 @@ NewtonResult NewtonSolver::solve(Vector& u, double tolerance) {
   auto finite = rcp(new NOX::StatusTest::FiniteValue);
   auto stagnation = rcp(new NOX::StatusTest::Stagnation(5, 0.999));
   auto crawl = rcp(new Crawl(impl_->solver.crawlIterations));
-  auto stall = rcp(new Stall);
+  auto stall = rcp(new Stall(impl_->stall));
   auto tests = rcp(new NOX::StatusTest::Combo(NOX::StatusTest::Combo::OR));
   tests->addStatusTest(finite);
   tests->addStatusTest(normF);
   tests->addStatusTest(maxIters);
   tests->addStatusTest(stagnation);
   tests->addStatusTest(crawl);
-  if (impl_->failOnStall) tests->addStatusTest(stall);
+  if (impl_->stall.window > 0) tests->addStatusTest(stall);
 
   NewtonResult r;
   NOX::StatusTest::StatusType status = NOX::StatusTest::Failed;
@@ -690,7 +689,7 @@ NewtonResult NewtonSolver::solve(Vector& u, double tolerance) {
     else if (stagnation->getStatus() == NOX::StatusTest::Failed) r.failure = "Newton stagnated";
     else if (stall->getStatus() == NOX::StatusTest::Failed)
       r.failure = format("Newton stalled (|R| fell by less than %g%% over %d iterations)",
-                         100 * (1 - Stall::kStallFactor), Stall::kStallWindow);
+                         100 * (1 - impl_->stall.factor), impl_->stall.window);
     else if (crawl->getStatus() == NOX::StatusTest::Failed)
       r.failure = format("Newton crawled (%d line-search steps of at most 1/8 in a row, |R| not halved)",
                          impl_->solver.crawlIterations);

@@ -27,6 +27,12 @@ struct NewtonResult {
   std::string failure;                  // why it did not converge
 };
 
+// A stall: |R| fell by less than 1 - factor over the last `window` iterations (window 0: no test).
+struct StallRule {
+  int window = 0;
+  double factor = 1;
+};
+
 class NewtonSolver {
  public:
   // `solver`: its Auto choices are resolved here (SolverSettings::resolved)
@@ -36,10 +42,10 @@ class NewtonSolver {
   // Solves R(u) = 0 from the initial guess u (updated in place) until
   // |R| <= tolerance.
   NewtonResult solve(Vector& u, double tolerance);
-  // While on, a solve fails once |R| has fallen by less than a tenth over its last 8 iterations
-  // (a stall): for solves whose failure has a cheaper way on, as steady rolling's start
-  // (docs/steady-rolling.md, "Failed tries in the start"). Off by default.
-  void failOnStall(bool on);
+  // While set, a solve fails on a stall (StallRule): for solves whose failure has a cheaper way
+  // on, as steady rolling's start (docs/steady-rolling.md, "Failed tries in the start"). Off
+  // (StallRule{}) by default.
+  void failOnStall(StallRule rule);
   // Pseudo-transient continuation (Kelley and Keyes 1998) to |R| <= tolerance: Newton with
   // |diag W| / dtau on the diagonal. Small dtau follows the force across rising |R| and indefinite
   // tangents, where the line search stalls; a failed solve's fallback. stepLengths: dtau.

@@ -38,6 +38,9 @@ class SteadyRolling {
   // kRetryStickSoftening); where those fail, from the footprint again through
   // friction at the held angular velocity, then the steady state.
   bool startFromRest(double t, StepRecord& rec, std::string& failure);
+  // Friction off and omega held: from the linear response, Newton failing on a quick stall
+  // (kFootprintStall) into pseudo-time; where that fails too, from rest again without the rule.
+  bool solveFootprint(double t, StepRecord& rec, std::string& failure);
   // Coulomb's frictions, and Tanh and Arctan ones much narrower than the
   // first start stage: those the start widens.
   std::vector<SteadyFrictionEffect*> frictionsStartedWide() const;
