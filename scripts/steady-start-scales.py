@@ -7,11 +7,13 @@ totals over many scenes. Scenes: the eight of the steady benchmarks (the drive, 
 brake sweep, the slice and the braked slice at 4x64 and 8x256, the Carter coating, the drive
 at mu = 2), twelve variants of the drive (friction 0.5-1.5, force 2 and 8 N, twice the speed,
 a brake, finer meshes and nips, Tanh 0.01) and, with --hard, fourteen hard cases (4x-9x the
-force, mu 1.1-1.3, Tanh and Arctan 1e-4, tangential penalties 1e-6 and 1). About 2 minutes a
-set (4 with --hard) on one core.
+force, mu 1.1-1.3, Tanh and Arctan 1e-4, tangential penalties 1e-6 and 1); with --more,
+seventeen further variants (3x, 5x and 10x the force, mu 0.9-1.7, tangential penalties 1e-5,
+1e-4 and 0.3, a brake, the slices at high friction and force, Arctan 1e-3). About 2 minutes a
+set (4 with --hard, 8 with both) on one core.
 
   scripts/steady-start-scales.py [--capstan build/capstan] [--sets "0.06,0.015,0.004;0.02,0.004"]
-                                 [--hard] [--out out/steady-start-scales]
+                                 [--hard] [--more] [--out out/steady-start-scales]
 """
 import argparse
 import os
@@ -55,6 +57,21 @@ HARD = [(f"drive, {f} N", DRIVE, [f"Supports/core/Force={{0, -{f}, 0}}"]) for f 
 ]
 
 
+F = "Capstans/capstan/Friction/"
+# --more: seventeen further variants, a check on defaults chosen over the groups above
+# (docs/steady-rolling.md, "Failed tries in the start").
+MORE = [(f"drive, {f} N", DRIVE, [f"Supports/core/Force={{0, -{f}, 0}}"]) for f in (12, 20, 40)] + [
+    (f"drive, mu {m}", DRIVE, [f"{F}Coefficient={m}"]) for m in (0.9, 1.05, 1.15, 1.4, 1.7)] + [
+    (f"drive, tangential penalty {e}", DRIVE, [f"{F}Tangential Penalty={e}"]) for e in ("1e-5", "1e-4", "0.3")] + [
+    ("drive, 16 N, mu 1.2", DRIVE, ["Supports/core/Force={0, -16, 0}", f"{F}Coefficient=1.2"]),
+    ("drive, brake 15 N mm", DRIVE, ["Supports/core/Torque=15"]),
+    ("slice, mu 1.5", SLICE, [f"{F}Coefficient=1.5"]),
+    ("slice, twice the force", SLICE, ["Supports/core/Force={0, -0.5, 0}"]),
+    ("braked slice, 4x the force, brake 4.4", BRAKED, ["Supports/core/Force={0, -1.0, 0}", "Supports/core/Torque=4.4"]),
+    ("drive, Arctan 1e-3", DRIVE, [f"{F}Law=Arctan", f"{F}Regularization=1e-3"]),
+]
+
+
 def newton(capstan, out, scene, sets):
     """Newton iterations of a run ('-' where it failed), with ' (N cuts)' where it was cut."""
     rc, _, s = run_scene(capstan, scene, out, sets)
@@ -71,10 +88,11 @@ def main():
     ap.add_argument("--sets", default="0.06,0.015,0.004;0.02,0.004",
                     help="sets of scales, ';' between sets (default: today's and the one before)")
     ap.add_argument("--hard", action="store_true", help="also the fourteen hard cases")
+    ap.add_argument("--more", action="store_true", help="also seventeen further variants")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "steady-start-scales"))
     a = ap.parse_args()
     sets = [s.strip() for s in a.sets.split(";") if s.strip()]
-    groups = [("scenes", SCENES)] + ([("hard cases", HARD)] if a.hard else [])
+    groups = [("scenes", SCENES)] + ([("hard cases", HARD)] if a.hard else []) + ([("more", MORE)] if a.more else [])
     table = {}
     for k, scales in enumerate(sets):
         for group, scenes in groups:

@@ -286,9 +286,12 @@ NewtonResult AugmentationLoop::solvePositions(double t, const Pass& pass, bool a
     // Where the retry failed too, before a cut: again in pseudo-time, past the |R| minimum that
     // stops the line search; Coulomb only where all slip or in a cut's short sub-steps, where the
     // path matters less (docs/friction.md, "What step 2 is, and the fallback for Tanh and Arctan").
-    if (!r.converged &&
-        (continuation_.regularised() || (continuation_.applies() && (pseudoTimeWithStick_ || everyPointSlips()))) &&
-        !(pass.number > 1 && r.residualNorm <= m_.absTolerance) && !afterStep) {
+    // Where no point sticks the answer does not depend on the path, and pseudo-time's steps may
+    // grow as fast as |R| falls; where points stick they follow the path, doubling.
+    const bool again = !r.converged && !(pass.number > 1 && r.residualNorm <= m_.absTolerance) && !afterStep;
+    const bool pathFree =
+        again && (continuation_.regularised() || (continuation_.applies() && everyPointSlips()));
+    if (again && (pathFree || (continuation_.applies() && pseudoTimeWithStick_))) {
       if (log_.on("newton"))
         log_.event("newton", format("newton failed (%s) in %d iterations: pseudo-transient continuation",
                                     r.failure.c_str(), r.iterations),
@@ -296,7 +299,7 @@ NewtonResult AugmentationLoop::solvePositions(double t, const Pass& pass, bool a
       rec.newton += r.iterations;
       rec.linear += r.linearIterations;
       m_.u->update(1.0, *start, 0.0);
-      r = m_.newton->pseudoTransient(*m_.u, pass.tolerance);
+      r = m_.newton->pseudoTransient(*m_.u, pass.tolerance, pathFree);
       if (log_.on("newton"))
         log_.event("newton", format("pseudo-transient continuation: %s in %d iterations, |R| %.3e",
                                     r.converged ? "converged" : "failed", r.iterations, r.residualNorm),

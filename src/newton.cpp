@@ -524,7 +524,7 @@ constexpr int kPseudoTimeIterations = 100;
 constexpr double kPseudoTimeSmallest = 1e-3;
 }  // namespace
 
-NewtonResult NewtonSolver::pseudoTransient(Vector& u, double tolerance) {
+NewtonResult NewtonSolver::pseudoTransient(Vector& u, double tolerance, bool growWithFall) {
   Assembly& assembly = impl_->assembly;
   const auto map = u.getMap();
   Vector f(map), dx(map), diag(map), trial(map), previous(map);
@@ -596,10 +596,10 @@ NewtonResult NewtonSolver::pseudoTransient(Vector& u, double tolerance) {
     r.stepLengths.push_back(dtau);
     // A step that turns back on the last one overshot (the tangent's model
     // switches across a kink, e.g. stick and slip): a shorter pseudo-time step.
-    // Otherwise dtau grows as |R| falls (switched evolution relaxation), at least doubling: where
-    // the force is balanced fast the steps become Newton's sooner (docs/friction.md, "What step 2 is").
+    // Otherwise dtau doubles, or grows as |R| falls (switched evolution relaxation): where the
+    // force is balanced fast the steps become Newton's sooner (docs/friction.md, "What step 2 is").
     const bool reversed = hasPrevious && dx.dot(previous) < -0.5 * dx.norm2() * previous.norm2();
-    dtau *= trialNorm <= 1.5 * norm && !reversed ? std::max(2.0, norm / trialNorm) : 0.5;
+    dtau *= trialNorm <= 1.5 * norm && !reversed ? std::max(2.0, growWithFall ? norm / trialNorm : 0.0) : 0.5;
     previous.update(1.0, dx, 0.0);
     hasPrevious = true;
     u.update(1.0, trial, 0.0);

@@ -49,7 +49,9 @@ class NewtonSolver {
   // Pseudo-transient continuation (Kelley and Keyes 1998) to |R| <= tolerance: Newton with
   // |diag W| / dtau on the diagonal. Small dtau follows the force across rising |R| and indefinite
   // tangents, where the line search stalls; a failed solve's fallback. stepLengths: dtau.
-  NewtonResult pseudoTransient(Vector& u, double tolerance);
+  // dtau doubles after a step that keeps |R| within 1.5x; with `growWithFall`, by |R|'s fall
+  // where that is more (where the answer does not depend on the path: docs/friction.md).
+  NewtonResult pseudoTransient(Vector& u, double tolerance, bool growWithFall);
   // One solve W x = b with matrix() as the caller assembled it (x: guess in, answer out), to the
   // relative `tolerance`, at most `maxIterations` if > 0: Krylov iterations, -1 on failure. Own: a
   // new preconditioner; Kept: Newton's, built if due; KeptAsBuilt: Newton's as it is.

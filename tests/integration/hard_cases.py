@@ -34,7 +34,7 @@ first order); a free core's translation too (2e-4 in steady rolling).
     there (77 Newton iterations); against the shipped scene;
   * the steady 3D drive with a very stiff stick (Tangential Penalty = 1e-6, 1/3400 of the
     automatic value): its first steady-state solve stalls and fails on the start's stall
-    test (NewtonSolver::failOnStall; before it, it ran on to the iteration limit, 60,
+    test after 4 iterations (NewtonSolver::failOnStall; before it, it ran on to the iteration limit, 60,
     and a retry through a smoothed stick/slip corner did again, 59), and the retry with a 10x softer stick converges (SteadyRolling::
     startFromRest, "Failed tries in the start" in docs/steady-rolling.md); 38 Newton
     iterations (154 before the stall test, 53 with a tenth over 8), within 50; against the shipped scene;
