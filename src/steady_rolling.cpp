@@ -56,7 +56,8 @@ class QuickerFailures {
   // |R| fell by less than a fifth over the last 4 iterations. It fails some solves that would
   // converge, where the cheaper way on costs less than their crawl: chosen by the totals over
   // those 34 scenes (1,504 against 1,650 with a tenth over 8, 1,551 with a fifth over 6) and 17
-  // others (1,530, 1,664, 1,591); a rule of 0.7 over 4 cut the 32 N drive (516 against 75).
+  // others (1,530, 1,664, 1,591; with two stage refinements); a rule of 0.7 over 4 cut the 32 N
+  // drive (516 against 75).
   static constexpr StallRule kStartStall{4, 0.8};
 
  private:
