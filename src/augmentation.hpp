@@ -60,6 +60,7 @@ class AugmentationLoop {
   // (RegularisationContinuation); off where the caller's own retry does better (steady
   // rolling's start: SteadyRolling::startFromRest).
   void allowCornerRetry(bool allow) { cornerRetry_ = allow; }
+  bool cornerRetryAllowed() const { return cornerRetry_; }
 
  private:
   // solve() once, with the step's preconditioner as it stands.

@@ -617,6 +617,7 @@ NewtonResult NewtonSolver::pseudoTransient(Vector& u, double tolerance, bool gro
 }
 
 void NewtonSolver::failOnStall(StallRule rule) { impl_->stall = rule; }
+StallRule NewtonSolver::stallRule() const { return impl_->stall; }
 
 NewtonResult NewtonSolver::solve(Vector& u, double tolerance) {
   Kokkos::Timer timer;

@@ -46,6 +46,7 @@ class NewtonSolver {
   // on, as steady rolling's start (docs/steady-rolling.md, "Failed tries in the start"). Off
   // (StallRule{}) by default.
   void failOnStall(StallRule rule);
+  StallRule stallRule() const;
   // Pseudo-transient continuation (Kelley and Keyes 1998) to |R| <= tolerance: Newton with
   // |diag W| / dtau on the diagonal. Small dtau follows the force across rising |R| and indefinite
   // tangents, where the line search stalls; a failed solve's fallback. stepLengths: dtau.
@@ -91,6 +92,21 @@ class NewtonSolver {
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+};
+
+// A solver's stall rule for a scope; the one before it again at the scope's end.
+class ScopedStallRule {
+ public:
+  ScopedStallRule(NewtonSolver& newton, StallRule rule) : newton_(newton), before_(newton.stallRule()) {
+    newton_.failOnStall(rule);
+  }
+  ~ScopedStallRule() { newton_.failOnStall(before_); }
+  ScopedStallRule(const ScopedStallRule&) = delete;
+  ScopedStallRule& operator=(const ScopedStallRule&) = delete;
+
+ private:
+  NewtonSolver& newton_;
+  StallRule before_;
 };
 
 }  // namespace capstan

@@ -45,14 +45,13 @@ constexpr StallRule kFootprintStall{3, 0.5};
 // against 2,098, the speed ratios within 2e-5 (docs/steady-rolling.md, "Failed tries in the start").
 class QuickerFailures {
  public:
-  QuickerFailures(NewtonSolver& newton, AugmentationLoop& augmentation) : newton_(newton), augmentation_(augmentation) {
-    newton_.failOnStall(kStartStall);
+  QuickerFailures(NewtonSolver& newton, AugmentationLoop& augmentation)
+      : stall_(newton, kStartStall), augmentation_(augmentation), cornerRetryBefore_(augmentation.cornerRetryAllowed()) {
     augmentation_.allowCornerRetry(false);
   }
-  ~QuickerFailures() {
-    newton_.failOnStall({});
-    augmentation_.allowCornerRetry(true);
-  }
+  ~QuickerFailures() { augmentation_.allowCornerRetry(cornerRetryBefore_); }
+  QuickerFailures(const QuickerFailures&) = delete;
+  QuickerFailures& operator=(const QuickerFailures&) = delete;
   // |R| fell by less than a fifth over the last 4 iterations. It fails some solves that would
   // converge, where the cheaper way on costs less than their crawl: chosen by the totals over
   // those 34 scenes (1,504 against 1,650 with a tenth over 8, 1,551 with a fifth over 6) and 17
@@ -61,8 +60,9 @@ class QuickerFailures {
   static constexpr StallRule kStartStall{4, 0.8};
 
  private:
-  NewtonSolver& newton_;
+  ScopedStallRule stall_;
   AugmentationLoop& augmentation_;
+  bool cornerRetryBefore_;
 };
 
 }  // namespace
@@ -130,10 +130,8 @@ bool SteadyRolling::solveFootprint(double t, StepRecord& rec, std::string& failu
   const int passes = m_.newton->direct() ? kGuessPasses : 0;
   {
     // Where frictions are present a stalled solve goes on in pseudo-time (AugmentationLoop).
-    m_.newton->failOnStall(kFootprintStall);
-    const bool ok = solveStage(t, "frictionless footprint", rec, failure, passes);
-    m_.newton->failOnStall({});
-    if (ok) return true;
+    const ScopedStallRule quick(*m_.newton, kFootprintStall);
+    if (solveStage(t, "frictionless footprint", rec, failure, passes)) return true;
   }
   if (log_.on("newton"))
     log_.event("newton", format("steady rolling: the footprint failed (%s): from rest again", failure.c_str()),
