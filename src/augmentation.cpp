@@ -287,10 +287,12 @@ NewtonResult AugmentationLoop::solvePositions(double t, const Pass& pass, bool a
     // stops the line search; Coulomb only where all slip or in a cut's short sub-steps, where the
     // path matters less (docs/friction.md, "What step 2 is, and the fallback for Tanh and Arctan").
     // Where no point sticks the answer does not depend on the path, and pseudo-time's steps may
-    // grow as fast as |R| falls; where points stick they follow the path, doubling.
+    // grow as fast as |R| falls; where points stick they follow the path, doubling. Regularised
+    // laws in Coulomb's place (steady rolling's start) only where the caller allows it.
     const bool again = !r.converged && !(pass.number > 1 && r.residualNorm <= m_.absTolerance) && !afterStep;
     const bool pathFree =
-        again && (continuation_.regularised() || (continuation_.applies() && everyPointSlips()));
+        again && (continuation_.regularised() || (pseudoTimeOnRegularised_ && lawsRegularisedNow()) ||
+                  (continuation_.applies() && everyPointSlips()));
     if (again && (pathFree || (continuation_.applies() && pseudoTimeWithStick_))) {
       if (log_.on("newton"))
         log_.event("newton", format("newton failed (%s) in %d iterations: pseudo-transient continuation",
@@ -560,6 +562,17 @@ NewtonResult AugmentationLoop::polish(double t, double start) {
   }
   r.residualHistory.push_back(r.residualNorm);
   return r;
+}
+
+bool AugmentationLoop::lawsRegularisedNow() const {
+  const auto& frictions = m_.assembly->frictionsPresent();
+  bool any = false;
+  for (const auto* f : frictions) {
+    if (!f->acting()) continue;
+    if (!f->regularisedLaw()) return false;
+    any = true;
+  }
+  return any;
 }
 
 bool AugmentationLoop::everyPointSlips() {

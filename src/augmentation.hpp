@@ -61,6 +61,9 @@ class AugmentationLoop {
   // rolling's start: SteadyRolling::startFromRest).
   void allowCornerRetry(bool allow) { cornerRetry_ = allow; }
   bool cornerRetryAllowed() const { return cornerRetry_; }
+  // Whether a failed solve under regularised laws that the scene did not ask to widen (steady
+  // rolling's Tanh stages in Coulomb's place) goes on in pseudo-time: off unless the caller asks.
+  void allowPseudoTimeOnRegularisedLaws(bool allow) { pseudoTimeOnRegularised_ = allow; }
 
  private:
   // solve() once, with the step's preconditioner as it stands.
@@ -130,6 +133,7 @@ class AugmentationLoop {
   // At u (evaluated here): whether no contact point of any capstan sticks
   // (every rank; false without friction).
   bool everyPointSlips();
+  bool lawsRegularisedNow() const;
 
   Model& m_;
   Log& log_;
@@ -141,6 +145,7 @@ class AugmentationLoop {
   bool lastStepShortened_ = false;                     // the last saddle-point step was halved
   bool pseudoTimeWithStick_ = false;                   // allowPseudoTimeWithStick
   bool cornerRetry_ = true;                            // allowCornerRetry
+  bool pseudoTimeOnRegularised_ = false;               // allowPseudoTimeOnRegularisedLaws
 };
 
 }  // namespace capstan

@@ -22,6 +22,10 @@ class FrictionEffect : public Effect {
   // Tanh and Arctan: the slip scale v is eps3 dt x `scale` (1: the scene's
   // law; src/regularisation_continuation.hpp widens it for a failed solve).
   void setRegularisationScale(double scale);
+  // Whether the law in force is a regularised one (steady rolling's start puts Tanh in Coulomb's place).
+  bool regularisedLaw() const {
+    return settings_.law == FrictionSettings::Law::Tanh || settings_.law == FrictionSettings::Law::Arctan;
+  }
   // Coulomb with the exact stick/slip corner (Friction/Smoothing = 0): whether
   // a failed solve may be retried through a smoothed corner, and that corner's
   // width for the retry (0: the scene's own again; RegularisationContinuation).
