@@ -37,9 +37,9 @@ constexpr double kRetryStickSoftening = 10;
 // pseudo-time too is tried again without the rule.
 constexpr StallRule kFootprintStall{3, 0.5};
 
-// While it lives, the start's tries (its Tanh stages and the steady state with each stick) fail
-// sooner, since each has a cheaper way on (a stage between, a softer stick, friction at the held
-// angular velocity): Newton's solves on a stall, rather than crawling to the iteration limit,
+// While it lives, the start's tries (its Tanh stages and the steady state with each stick), and a
+// continuation step's, fail sooner, since each has a cheaper way on (a stage between, a softer
+// stick, friction at the held angular velocity, the start's wider laws): Newton's solves on a stall, rather than crawling to the iteration limit,
 // and Coulomb's without the smoothed stick/slip corner's retry, which converged in 2 of 12 tries.
 // Over the 34 scenes of `scripts/steady-start-scales.py --hard` 1,504 Newton iterations from rest
 // against 2,098, the speed ratios within 2e-5 (docs/steady-rolling.md, "Failed tries in the start").
@@ -76,6 +76,12 @@ bool SteadyRolling::solve(double t, StepRecord& rec, std::string& failure) {
     started_ = startFromRest(t, rec, failure);
     return started_;
   }
+  // A continuation step's tries fail fast as the start's do: the first has the start's wider
+  // laws to go on with, they a cut. The drive's force ramped over two steps to 7x-10x: second
+  // steps of 57, 61, 49 and 118 Newton iterations against 192, 308, 149 and 268 (the first try
+  // had crawled to the iteration limit, twice, and the Tanh stages after it); the steps of the
+  // scenes of "The scales" take what they took (docs/steady-rolling.md, "Large indentation").
+  const QuickerFailures quicker(*m_.newton, augmentation_);
   const auto before = m_.snapshot();
   if (solveStage(t, "steady state", rec, failure, 0, false)) {
     wideRetryUsed_ = false;
