@@ -61,7 +61,8 @@ first order); a free core's translation too (2e-4 in steady rolling).
     of them is solved again with pseudo-time behind Newton, and the stages after it
     converge in 1-3 iterations each (SteadyRolling::startThroughWideLaws): 139 Newton
     iterations, no cut, within 180 (874 and 3 cuts before); against the force ramped over
-    two steps (322; 775 and 2 cuts before).
+    two steps (172, its second step's tries failing fast as the start's; 775 and 2 cuts
+    before).
 
 Then the steady 3D drive with a fine nip over thick outer cells (3x120x8, 0.28-degree nip
 cells on 3 radial cells, the sector centred on the nip), where Coulomb's stick and slip
