@@ -133,6 +133,7 @@ class AugmentationLoop {
   // At u (evaluated here): whether no contact point of any capstan sticks
   // (every rank; false without friction).
   bool everyPointSlips();
+  // Whether some friction acts and every acting one's law is regularised now.
   bool lawsRegularisedNow() const;
 
   Model& m_;

@@ -39,8 +39,9 @@ constexpr StallRule kFootprintStall{3, 0.5};
 
 // While it lives, the start's tries (its Tanh stages and the steady state with each stick), and a
 // continuation step's, fail sooner, since each has a cheaper way on (a stage between, a softer
-// stick, friction at the held angular velocity, the start's wider laws): Newton's solves on a stall, rather than crawling to the iteration limit,
-// and Coulomb's without the smoothed stick/slip corner's retry, which converged in 2 of 12 tries.
+// stick, friction at the held angular velocity, the start's wider laws): Newton's solves on a
+// stall, rather than crawling to the iteration limit, and Coulomb's without the smoothed
+// stick/slip corner's retry, which converged in 2 of 12 tries.
 // Over the 34 scenes of `scripts/steady-start-scales.py --hard` 1,504 Newton iterations from rest
 // against 2,098, the speed ratios within 2e-5 (docs/steady-rolling.md, "Failed tries in the start").
 class QuickerFailures {
