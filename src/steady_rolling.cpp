@@ -77,11 +77,12 @@ bool SteadyRolling::solve(double t, StepRecord& rec, std::string& failure) {
     started_ = startFromRest(t, rec, failure);
     return started_;
   }
-  // A continuation step's tries fail fast as the start's do: the first has the start's wider
-  // laws to go on with, they a cut. The drive's force ramped over two steps to 7x-10x: second
-  // steps of 57, 61, 49 and 118 Newton iterations against 192, 308, 149 and 268 (the first try
-  // had crawled to the iteration limit, twice, and the Tanh stages after it); the steps of the
-  // scenes of "The scales" take what they took (docs/steady-rolling.md, "Large indentation").
+  // A continuation step's tries fail fast as the start's do: the first try has the start's
+  // wider laws to go on with, and those have the step's cut. The drive's force ramped over two
+  // steps to 7x-10x: second steps of 57, 61, 49 and 118 Newton iterations against 192, 308, 149
+  // and 268 (the first try had crawled to the iteration limit twice, and the Tanh stages after
+  // it too); the steps of the scenes of "The scales" take what they took (docs/steady-rolling.md,
+  // "Large indentation").
   const QuickerFailures quicker(*m_.newton, augmentation_);
   const auto before = m_.snapshot();
   if (solveStage(t, "steady state", rec, failure, 0, false)) {
