@@ -62,7 +62,7 @@ first order); a free core's translation too (2e-4 in steady rolling).
     converge in 1-3 iterations each (SteadyRolling::startThroughWideLaws): 139 Newton
     iterations, no cut, within 180 (874 and 3 cuts before); against the force ramped over
     two steps (172, its second step's tries failing fast as the start's; 775 and 2 cuts
-    before).
+    before). Its log must show a start stage converged in pseudo-time.
 
 Then the steady 3D drive with a fine nip over thick outer cells (3x120x8, 0.28-degree nip
 cells on 3 radial cells, the sector centred on the nip), where Coulomb's stick and slip
@@ -236,6 +236,20 @@ if s is not None:
             f"solves converged: {pseudo} (expected [True])")
     T.check(footprint and footprint[0] <= 12,
             f"4x force: the frictionless footprint in {footprint} Newton iterations (<= 12; 27 before)")
+
+# --- 10x force: the start's stages between spent, pseudo-time behind Newton -------------
+p, s, out = T.run_scene(T.input("pinch-roller-steady.xml"), "start-10x", sets=[F10, NOFIELDS],
+                        extra=["--log", "newton"])
+if s is not None:
+    pseudo, stage = [], ""
+    for e in T.log_events(out):
+        if e.get("event") == "steady stage":
+            stage = e["stage"]
+        if stage.startswith("start: slip speed scale") and e.get("event") == "pseudo_transient_end":
+            pseudo.append(e["converged"] is True)
+    cuts = sum(st["cutbacks"] for st in s["steps"])
+    T.check(s["converged"] and cuts == 0, f"10x force: converged {s['converged']}, {cuts} cuts (expected none)")
+    T.check(True in pseudo, f"10x force: a start stage converged in pseudo-time behind Newton ({pseudo})")
 
 # --- stick and slip that cycle: points held in slip ----------------------------------
 FINE_NIP = ["Mesh/Cells={3, 120, 8}", "Mesh/Fine Sector={-90, 20, 0.6}", NOFIELDS]
