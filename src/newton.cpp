@@ -283,7 +283,8 @@ struct NewtonSolver::Impl {
   double preconditionerSeconds = 0;  // part of linearSeconds
   // A solver's exception on one rank alone, made every rank's (or the job's end).
   FailureAgreement agreement;
-  StallRule stall;  // off: window 0
+  StallRule stall;            // off: window 0
+  StallRule pseudoTimeStall;  // off: window 0
   Impl(Assembly& a, const SolverSettings& s) : assembly(a), solver(s), agreement(a.dofMap()->getComm()) {}
 
   RCP<Teuchos::ParameterList> noxParameters(const RCP<NOX::Observer>& observer) const {
@@ -551,8 +552,12 @@ NewtonResult NewtonSolver::pseudoTransient(Vector& u, double tolerance, bool gro
   bool valid = assembly.evaluate(u, &f, nullptr);
   double norm = f.norm2();  // collective: every rank
   r.residualHistory.push_back(norm);
+  // The lowest |R| after each iteration, for the stall rule.
+  std::vector<double> lowest{norm};
+  const StallRule stall = impl_->pseudoTimeStall;
+  bool stalled = false;
   while (valid && std::isfinite(norm) && norm > tolerance && r.iterations < kPseudoTimeIterations &&
-         dtau >= kPseudoTimeSmallest) {
+         dtau >= kPseudoTimeSmallest && !stalled) {
     assembly.evaluate(u, &f, W.get());
     // W + |diag W| / dtau on the free rows (a held row's unit diagonal stays).
     W->getLocalDiagCopy(diag);
@@ -605,12 +610,17 @@ NewtonResult NewtonSolver::pseudoTransient(Vector& u, double tolerance, bool gro
     u.update(1.0, trial, 0.0);
     norm = trialNorm;
     r.residualHistory.push_back(norm);
+    lowest.push_back(std::min(lowest.back(), norm));
+    const size_t w = size_t(stall.window), k = lowest.size() - 1;
+    stalled = w > 0 && k >= w && lowest[k] > stall.factor * lowest[k - w];
   }
   r.residualNorm = norm;
   r.converged = valid && std::isfinite(norm) && norm <= tolerance;
   if (!r.converged && r.failure.empty())
-    r.failure = std::string(r.iterations >= kPseudoTimeIterations ? "pseudo-transient continuation: iteration limit reached"
-                                                                  : "pseudo-transient continuation failed") +
+    r.failure = std::string(stalled ? format("pseudo-transient continuation stalled (its lowest |R| fell by less than %g%% "
+                                             "over %d iterations)", 100 * (1 - stall.factor), stall.window)
+                            : r.iterations >= kPseudoTimeIterations ? "pseudo-transient continuation: iteration limit reached"
+                                                                    : "pseudo-transient continuation failed") +
                 residualsReached(r.residualHistory, tolerance);
   assembly.evaluate(u, nullptr, nullptr);  // the effects' state at u
   return r;
@@ -618,6 +628,8 @@ NewtonResult NewtonSolver::pseudoTransient(Vector& u, double tolerance, bool gro
 
 void NewtonSolver::failOnStall(StallRule rule) { impl_->stall = rule; }
 StallRule NewtonSolver::stallRule() const { return impl_->stall; }
+void NewtonSolver::failPseudoTimeOnStall(StallRule rule) { impl_->pseudoTimeStall = rule; }
+StallRule NewtonSolver::pseudoTimeStallRule() const { return impl_->pseudoTimeStall; }
 
 NewtonResult NewtonSolver::solve(Vector& u, double tolerance) {
   Kokkos::Timer timer;

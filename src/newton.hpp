@@ -47,6 +47,10 @@ class NewtonSolver {
   // (StallRule{}) by default.
   void failOnStall(StallRule rule);
   StallRule stallRule() const;
+  // The same for pseudo-time (pseudoTransient), whose |R| swings: it fails where its lowest |R|
+  // fell by less than 1 - factor over the last `window` iterations. Off by default.
+  void failPseudoTimeOnStall(StallRule rule);
+  StallRule pseudoTimeStallRule() const;
   // Pseudo-transient continuation (Kelley and Keyes 1998) to |R| <= tolerance: Newton with
   // |diag W| / dtau on the diagonal. Small dtau follows the force across rising |R| and indefinite
   // tangents, where the line search stalls; a failed solve's fallback. stepLengths: dtau.
@@ -94,19 +98,25 @@ class NewtonSolver {
   std::unique_ptr<Impl> impl_;
 };
 
-// A solver's stall rule for a scope; the one before it again at the scope's end.
+// A solver's stall rules (Newton's, and pseudo-time's) for a scope; the ones before them again at
+// the scope's end.
 class ScopedStallRule {
  public:
-  ScopedStallRule(NewtonSolver& newton, StallRule rule) : newton_(newton), before_(newton.stallRule()) {
+  ScopedStallRule(NewtonSolver& newton, StallRule rule, StallRule pseudoTime = {})
+      : newton_(newton), before_(newton.stallRule()), pseudoTimeBefore_(newton.pseudoTimeStallRule()) {
     newton_.failOnStall(rule);
+    newton_.failPseudoTimeOnStall(pseudoTime);
   }
-  ~ScopedStallRule() { newton_.failOnStall(before_); }
+  ~ScopedStallRule() {
+    newton_.failOnStall(before_);
+    newton_.failPseudoTimeOnStall(pseudoTimeBefore_);
+  }
   ScopedStallRule(const ScopedStallRule&) = delete;
   ScopedStallRule& operator=(const ScopedStallRule&) = delete;
 
  private:
   NewtonSolver& newton_;
-  StallRule before_;
+  StallRule before_, pseudoTimeBefore_;
 };
 
 }  // namespace capstan

@@ -39,7 +39,8 @@ class SteadyRolling {
   // friction at the held angular velocity, then the steady state.
   bool startFromRest(double t, StepRecord& rec, std::string& failure);
   // Friction off and omega held: from the linear response, Newton failing on a quick stall
-  // (kFootprintStall) into pseudo-time; where that fails too, from rest again without the rule.
+  // (kFootprintStall) into pseudo-time, which fails on its own stall; without friction (no
+  // pseudo-time) from rest again without the rule.
   bool solveFootprint(double t, StepRecord& rec, std::string& failure);
   // Coulomb's frictions, and Tanh and Arctan ones much narrower than the
   // first start stage: those the start widens.

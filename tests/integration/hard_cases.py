@@ -56,6 +56,11 @@ first order); a free core's translation too (2e-4 in steady rolling).
     (SteadyRolling::solveFootprint): the log shows the pseudo-time solve converged in the
     footprint, which takes at most 12 Newton iterations (8 now, 27 before), against the
     force ramped over two steps;
+  * the steady 3D drive pressed 16x harder (64 N): the frictionless footprint's pseudo-time
+    cycles at the wide contact's edge; it fails once its lowest |R| has not halved over 20
+    iterations, and the step's cut (half the force) converges: 174 Newton iterations, within
+    230 (337 before, the pseudo-time to its 100-iteration limit, and again from rest), against
+    the force ramped over two steps; the log shows one failed footprint pseudo-time solve;
   * the steady 3D drive pressed 10x harder (40 N): its Tanh stage at 0.004 fails from the
     0.015 answer, and so do the four stages between (Newton stalls at |R| ~ 1e-2); the last
     of them is solved again with pseudo-time behind Newton, and the stages after it
@@ -108,6 +113,7 @@ NOFIELDS = "Output/Write Fields=false"
 F8 = "Supports/core/Force={0, -32, 0}"
 F4 = "Supports/core/Force={0, -16, 0}"
 F10 = "Supports/core/Force={0, -40, 0}"
+F16 = "Supports/core/Force={0, -64, 0}"
 EPST1 = "Capstans/capstan/Friction/Tangential Penalty=1"
 EPST6 = "Capstans/capstan/Friction/Tangential Penalty=1e-6"
 HERTZ400 = "Supports/core/Force={0, -2, 0}"
@@ -173,6 +179,9 @@ CASES = [
      "Supports/core/Force Ramp Time=0.002"], 5e-5, 100),
     ("steady drive 10x force", "pinch-roller-steady.xml", [F10, NOFIELDS], [F10, NOFIELDS, "Time/Steps=2",
      "Supports/core/Force Ramp Time=0.002"], 5e-5, 180),
+    # 337 Newton iterations before the footprint's pseudo-time stall (its cycling to the limit, twice).
+    ("steady drive 16x force", "pinch-roller-steady.xml", [F16, NOFIELDS], [F16, NOFIELDS, "Time/Steps=2",
+     "Supports/core/Force Ramp Time=0.002"], 5e-5, 230),
 ]
 
 
@@ -250,6 +259,21 @@ if s is not None:
     cuts = sum(st["cutbacks"] for st in s["steps"])
     T.check(s["converged"] and cuts == 0, f"10x force: converged {s['converged']}, {cuts} cuts (expected none)")
     T.check(True in pseudo, f"10x force: a start stage converged in pseudo-time behind Newton ({pseudo})")
+
+# --- 16x force: the footprint's pseudo-time cycles, fails on its stall, the cut eases the force --
+p, s, out = T.run_scene(T.input("pinch-roller-steady.xml"), "start-16x", sets=[F16, NOFIELDS],
+                        extra=["--log", "newton"])
+if s is not None:
+    failed, stage = [], ""
+    for e in T.log_events(out):
+        if e.get("event") == "steady stage":
+            stage = e["stage"]
+        if stage == "frictionless footprint" and e.get("event") == "pseudo_transient_end" and e["converged"] is not True:
+            failed.append(e["iterations"])
+    cuts = sum(st["cutbacks"] for st in s["steps"])
+    T.check(s["converged"] and cuts == 1, f"16x force: converged {s['converged']}, {cuts} cuts (expected 1: half the force)")
+    T.check(len(failed) == 1 and failed[0] < 60, f"16x force: one footprint's pseudo-time failed, on its stall rule "
+            f"within 60 iterations ({failed}; before, [100, 100]: the iteration limit, and again from rest)")
 
 # --- stick and slip that cycle: points held in slip ----------------------------------
 FINE_NIP = ["Mesh/Cells={3, 120, 8}", "Mesh/Fine Sector={-90, 20, 0.6}", NOFIELDS]
