@@ -263,8 +263,11 @@ NewtonResult AugmentationLoop::solvePositions(double t, const Pass& pass, bool a
     r.converged = true, r.residualNorm = pass.start, r.residualHistory = {pass.start};
   } else {
     // The solve's start, for a retry through wider friction laws or a smoothed
-    // stick/slip corner, and in pseudo-time (only kept where there is one).
-    const RCP<Vector> start = continuation_.applies() ? rcp(new Vector(*m_.u, Teuchos::Copy)) : Teuchos::null;
+    // stick/slip corner, and in pseudo-time (only kept where there is one: the
+    // steady start's regularised laws too, where a scene's Coulomb has its own
+    // smoothed corner and no retry).
+    const bool retries = continuation_.applies() || pseudoTimeOnRegularised_;
+    const RCP<Vector> start = retries ? rcp(new Vector(*m_.u, Teuchos::Copy)) : Teuchos::null;
     r = pass.polish ? polish(t, pass.start) : m_.newton->solve(*m_.u, pass.tolerance);
     // Neither retry after a saddle-point step: undoing the step is the remedy
     // there (solve()). The steady drive under Tanh, eps3 = 1e-4, ran the whole

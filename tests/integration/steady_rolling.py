@@ -8,6 +8,8 @@ slice (inputs/pinch-roller-slice-steady.xml, inputs/pinch-roller-braked-steady.x
   * 1 and 2 ranks agree to 1e-8 (every force, torque, angular velocity, speed ratio,
     slip power, nip figure) and write the same nip.csv rows; Linear Solver = GMRES (its
     Auto preconditioner then the LU) converges to the same speed ratio (1e-4: the path);
+  * a braked slice whose Coulomb has its own smoothed corner, beyond the traction limit:
+    exit 2 with the reason and its converged steps (it crashed in the start's pseudo-time);
   * frictionless, the steady state is the static indentation of the same scene
     (Analysis/Type = Quasi-Static, the core's rotation held): forces, core translation,
     peak pressure and contact width to 1e-8;
@@ -191,6 +193,23 @@ if s:
     T.check(done == [1, 2], f"converged steps kept: {done}")
     steps = {int(r["step"]) for r in nip_rows(out)}
     T.check(steps == set(done), f"nip.csv holds the converged steps {sorted(steps)}")
+
+# -- the same with the scene's own smoothed corner: the start's pseudo-time keeps its start ------
+# A braked slice whose Coulomb has Friction/Smoothing (so no corner retry) beyond the limit: its
+# last step goes again through the start's wider laws and their pseudo-time, which restarted
+# from a start the augmentation loop had not kept (a segmentation fault; the randomized sweep).
+slice_scene = T.input("pinch-roller-slice-steady.xml")
+p, s, out = T.run_scene(slice_scene, "smoothed-beyond-limit", expect_rc=2,
+                        sets=NOFIELDS + ["Capstans/capstan/Friction/Smoothing=0.0765",
+                                         "Capstans/capstan/Friction/Tangential Penalty=0.00439",
+                                         "Capstans/capstan/Friction/Coefficient=0.77", "Time/Steps=4",
+                                         "Supports/core/Torque=1.36", "Supports/core/Torque Ramp Time=0.004"])
+if s:
+    T.conforms(out, slice_scene)
+    T.check(s["converged"] is False and "can carry" in (s.get("failure") or ""),
+            f"smoothed corner beyond the limit: the failure names the traction limit: {s.get('failure')!r}")
+    T.check([st["step"] for st in s["steps"]] == [1, 2, 3], f"smoothed corner: converged steps kept "
+            f"{[st['step'] for st in s['steps']]}")
 
 # -- a nip about one cell wide: frozen states, no negative dissipation ---------------
 drive = T.input("pinch-roller-steady.xml")
