@@ -229,18 +229,30 @@ for i, (name, scene, sets, ref_sets, pen_tol, budget, *rest) in enumerate(CASES)
         T.check(abs(core["speed_ratio"] - ref_core["speed_ratio"]) <= 2e-5,
                 f"{name}: speed ratio {core['speed_ratio']:.6f} against {ref_core['speed_ratio']:.6f} (2e-5)")
 
+
+def pseudo_time_ends(out, in_stage):
+    """The pseudo-time solves of a --log newton run's steady stages whose name passes IN_STAGE:
+    (converged, iterations) each, in order."""
+    ends, stage = [], ""
+    for e in T.log_events(out):
+        if e.get("event") == "steady stage":
+            stage = e["stage"]
+        if in_stage(stage) and e.get("event") == "pseudo_transient_end":
+            ends.append((e["converged"] is True, e["iterations"]))
+    return ends
+
+
+def is_footprint(stage):
+    return stage == "frictionless footprint"
+
+
 # --- a heavy load's footprint: Newton's crawl cut short, pseudo-time on -----------------
 p, s, out = T.run_scene(T.input("pinch-roller-steady.xml"), "footprint-4x", sets=[F4, NOFIELDS],
                         extra=["--log", "newton"])
 if s is not None:
-    footprint, pseudo, stage = [], [], ""
-    for e in T.log_events(out):
-        if e.get("event") == "steady stage":
-            stage = e["stage"]
-        if stage == "frictionless footprint" and e.get("event") == "pseudo_transient_end":
-            pseudo.append(e["converged"] is True)
-        if e.get("topic") == "progress" and "frictionless footprint: done, newton=" in e.get("text", ""):
-            footprint.append(int(e["text"].split("newton=")[1].split(",")[0]))
+    pseudo = [ok for ok, _ in pseudo_time_ends(out, is_footprint)]
+    footprint = [int(e["text"].split("newton=")[1].split(",")[0]) for e in T.log_events(out)
+                 if e.get("topic") == "progress" and "frictionless footprint: done, newton=" in e.get("text", "")]
     T.check(s["converged"] and pseudo == [True], f"4x force: converged {s['converged']}, the footprint's pseudo-time "
             f"solves converged: {pseudo} (expected [True])")
     T.check(footprint and footprint[0] <= 12,
@@ -250,12 +262,7 @@ if s is not None:
 p, s, out = T.run_scene(T.input("pinch-roller-steady.xml"), "start-10x", sets=[F10, NOFIELDS],
                         extra=["--log", "newton"])
 if s is not None:
-    pseudo, stage = [], ""
-    for e in T.log_events(out):
-        if e.get("event") == "steady stage":
-            stage = e["stage"]
-        if stage.startswith("start: slip speed scale") and e.get("event") == "pseudo_transient_end":
-            pseudo.append(e["converged"] is True)
+    pseudo = [ok for ok, _ in pseudo_time_ends(out, lambda stage: stage.startswith("start: slip speed scale"))]
     cuts = sum(st["cutbacks"] for st in s["steps"])
     T.check(s["converged"] and cuts == 0, f"10x force: converged {s['converged']}, {cuts} cuts (expected none)")
     T.check(True in pseudo, f"10x force: a start stage converged in pseudo-time behind Newton ({pseudo})")
@@ -264,12 +271,7 @@ if s is not None:
 p, s, out = T.run_scene(T.input("pinch-roller-steady.xml"), "start-16x", sets=[F16, NOFIELDS],
                         extra=["--log", "newton"])
 if s is not None:
-    failed, stage = [], ""
-    for e in T.log_events(out):
-        if e.get("event") == "steady stage":
-            stage = e["stage"]
-        if stage == "frictionless footprint" and e.get("event") == "pseudo_transient_end" and e["converged"] is not True:
-            failed.append(e["iterations"])
+    failed = [its for ok, its in pseudo_time_ends(out, is_footprint) if not ok]
     cuts = sum(st["cutbacks"] for st in s["steps"])
     T.check(s["converged"] and cuts == 1, f"16x force: converged {s['converged']}, {cuts} cuts (expected 1: half the force)")
     T.check(len(failed) == 1 and failed[0] < 60, f"16x force: one footprint's pseudo-time failed, on its stall rule "
