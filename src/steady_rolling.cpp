@@ -78,6 +78,27 @@ SteadyRolling::SteadyRolling(Model& model, Log& log, AugmentationLoop& augmentat
     : m_(model), log_(log), augmentation_(augmentation), predictors_(predictors), started_(started) {}
 
 bool SteadyRolling::solve(double t, StepRecord& rec, std::string& failure) {
+  if (!solveSteadyState(t, rec, failure)) return false;
+  failure = rollerTurningBackwards();
+  return failure.empty();
+}
+
+std::string SteadyRolling::rollerTurningBackwards() const {
+  // A free roller turns with the capstan's surface: where its surface runs backwards (a negative
+  // speed ratio) the nip cannot have carried it, and the state is the mesh's, not the scene's. The
+  // drive on 4 cells round with the capstan reversed converged with a speed ratio of -13.8
+  // (randomized sweep 12; 8 cells round: 0.967, the shipped mesh 0.987).
+  for (const auto& core : m_.assembly->rigidCores()) {
+    const double rolling = noSlipAngularVelocity(m_.scene, core);
+    if (!core.free[3] || core.holding() || rolling == 0 || core.angularVelocity / rolling >= 0) continue;
+    return format("support '%s': the steady state found has the roller's surface running against the capstan's "
+                  "(speed ratio %.4g), which no nip carries: the mesh does not resolve the nip (finer Mesh/Cells "
+                  "round the ring)", core.name.c_str(), core.angularVelocity / rolling);
+  }
+  return "";
+}
+
+bool SteadyRolling::solveSteadyState(double t, StepRecord& rec, std::string& failure) {
   if (!started_) {
     started_ = startFromRest(t, rec, failure);
     return started_;

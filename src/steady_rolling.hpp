@@ -33,6 +33,10 @@ class SteadyRolling {
   bool solve(double t, StepRecord& rec, std::string& failure);
 
  private:
+  // The steady state (the start from rest, or the continuation from u).
+  bool solveSteadyState(double t, StepRecord& rec, std::string& failure);
+  // Why the state in u is no answer: a free roller turning against the capstan; "" if none does.
+  std::string rollerTurningBackwards() const;
   // The footprint, then (Coulomb) the Tanh stages and the steady state (where
   // it fails, again from the Tanh answer with a softer stick,
   // kRetryStickSoftening); where those fail, from the footprint again through

@@ -23,6 +23,11 @@ the points of faces much longer than its diameter. Both converged before with ex
     longer than its diameter. (The check's geometry, kernels::faceCut, is tested in
     tests/test_contact_kernel.cpp.)
 
+A free roller whose surface runs against the capstan's (a negative speed ratio) is no
+steady state either: the drive on 4 cells round with the capstan reversed converged with
+-13.8; now each try is refused and the run ends with exit 2, the reason on the progress
+lines (SteadyRolling::rollerTurningBackwards).
+
 Soft penalties (20x and 640x softer than formulation.md's range) sink the contact points
 themselves into the capstan, and still converge: the bound counts from their penetration.
 
@@ -74,6 +79,19 @@ if four is not None and four["converged"]:
     T.check(0.9 < ratio < 1.1, f"four cells round: speed ratio {ratio:.4f} (0.9-1.1: the capstan outside)")
 else:
     T.check(False, "four cells round: converged")
+
+# The same mesh with the capstan reversed converged to a roller turning against it, 14x fast
+# (speed ratio -13.8; randomized sweep 12): no nip carries that, so the step fails and the run
+# ends with exit 2, saying why (8 cells round converge: 0.967).
+p, back, out = T.run_scene(DRIVE, "four-cells-reversed", expect_rc=2, quiet=False,
+                           sets=["Mesh/Cells={4, 4, 6}", "Capstans/capstan/Angular Velocity=-19.05",
+                                 "Output/Write Fields=false"])
+T.check("running against the capstan's" in p.stdout, "four cells round, capstan reversed: the roller turning "
+        "backwards is refused, said on the progress lines")
+if back is not None:
+    T.conforms(out, DRIVE)
+    T.check(back["converged"] is False and not back["steps"], f"four cells round, capstan reversed: no step "
+            f"converged ({len(back['steps'])} written)")
 
 # Soft penalties sink the contact points themselves into the capstan: that is the penalty's
 # model, not a body through the capstan (the earlier sweeps' runs, which converged before
