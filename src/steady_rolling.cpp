@@ -78,9 +78,12 @@ SteadyRolling::SteadyRolling(Model& model, Log& log, AugmentationLoop& augmentat
     : m_(model), log_(log), augmentation_(augmentation), predictors_(predictors), started_(started) {}
 
 bool SteadyRolling::solve(double t, StepRecord& rec, std::string& failure) {
+  const bool wasStarted = started_;
   if (!solveSteadyState(t, rec, failure)) return false;
   failure = rollerTurningBackwards();
-  return failure.empty();
+  if (failure.empty()) return true;
+  started_ = wasStarted;  // the caller restores u: a refused start from rest starts from rest again
+  return false;
 }
 
 std::string SteadyRolling::rollerTurningBackwards() const {
