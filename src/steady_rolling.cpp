@@ -71,6 +71,25 @@ class QuickerFailures {
   bool cornerRetryBefore_;
 };
 
+// Pseudo-time behind the start's regularised stages: allowed once the stages between are spent,
+// withdrawn when the start ends however it ends.
+class RegularisedPseudoTime {
+ public:
+  explicit RegularisedPseudoTime(AugmentationLoop& augmentation) : augmentation_(augmentation) {}
+  ~RegularisedPseudoTime() { augmentation_.allowPseudoTimeOnRegularisedLaws(false); }
+  RegularisedPseudoTime(const RegularisedPseudoTime&) = delete;
+  RegularisedPseudoTime& operator=(const RegularisedPseudoTime&) = delete;
+  void allow() {
+    augmentation_.allowPseudoTimeOnRegularisedLaws(true);
+    allowed_ = true;
+  }
+  bool allowed() const { return allowed_; }
+
+ private:
+  AugmentationLoop& augmentation_;
+  bool allowed_ = false;
+};
+
 }  // namespace
 
 SteadyRolling::SteadyRolling(Model& model, Log& log, AugmentationLoop& augmentation, Predictors& predictors,
@@ -242,7 +261,7 @@ bool SteadyRolling::startThroughWideLaws(double t, const std::vector<SteadyFrict
   // (asked before the first stage turns Coulomb's effects into Tanh).
   const bool coulomb = std::any_of(widened.begin(), widened.end(), [](auto* f) { return f->augmented(); });
   int refinements = 0;
-  bool pseudoTime = false;
+  RegularisedPseudoTime pseudoTime(augmentation_);
   for (int k = 0; k < int(scales.size()); ++k) {
     const double scale = scales[k];
     int wider = 0;
@@ -258,7 +277,7 @@ bool SteadyRolling::startThroughWideLaws(double t, const std::vector<SteadyFrict
     ok = solveStage(t, stage.c_str(), rec, failure, kGuessPasses);
     if (ok) continue;
     if (refinements == kStageRefinements) {
-      if (pseudoTime) break;
+      if (pseudoTime.allowed()) break;
       // The stages between spent: this one again, and the rest, with pseudo-time behind each
       // Newton solve (the laws are regularised: the answer does not depend on the path), and
       // as many stages between again. The drive at 10x force stalls at |R| ~ 1e-2 at every
@@ -267,9 +286,8 @@ bool SteadyRolling::startThroughWideLaws(double t, const std::vector<SteadyFrict
       // 8-22 more on three scenes whose stages between converge (docs/steady-rolling.md,
       // "Large indentation").
       m_.restore(before);
-      pseudoTime = true;
+      pseudoTime.allow();
       refinements = 0;
-      augmentation_.allowPseudoTimeOnRegularisedLaws(true);
       ok = true;
       --k;
       continue;
@@ -282,7 +300,6 @@ bool SteadyRolling::startThroughWideLaws(double t, const std::vector<SteadyFrict
     ok = true;
     --k;
   }
-  augmentation_.allowPseudoTimeOnRegularisedLaws(false);
   if (ok) m_.assembly->evaluate(*m_.u, nullptr, nullptr);  // the tractions Coulomb starts from
   for (auto* f : widened) f->useSceneLaw(ok);
   return ok;
