@@ -412,6 +412,14 @@ void AugmentationLoop::moveByPressureStep(double t, Vector& f, const Constraints
                                           PassPolicy& passes, std::optional<StepStart>& beforeStep,
                                           StepRecord& rec) {
   const auto& effects = m_.assembly->effects();
+  // A step alone with nothing to step (the volumes met, no rows of its own unmet): the state is
+  // no equilibrium, so the plain update would be no augmentation. Newton first. From rest
+  // (`Predictor = Previous`) contact's update pushed the Hertz ring's overlapping points off with
+  // eps g, and every cut of step 1 crawled after it.
+  if (stepAlone && c.volumeMet && !c.rowsUnmet) {
+    passes.newtonNext();
+    return;
+  }
   // The other multipliers first: the pressure step then re-balances the
   // body under their new values too, so their change does not spoil the
   // volumes it makes exact.
