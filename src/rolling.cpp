@@ -20,6 +20,11 @@ double noSlipAngularVelocity(const Scene& scene, const RigidCore& core) {
   return 0;
 }
 
+double speedRatio(const Scene& scene, const RigidCore& core, double angularVelocity) {
+  const double rolling = noSlipAngularVelocity(scene, core);
+  return rolling != 0 ? angularVelocity / rolling : std::nan("");
+}
+
 std::string brakeDiagnosis(const Scene& scene) {
   std::string out;
   if (scene.mesh.type != MeshSpec::Type::Annulus) return out;

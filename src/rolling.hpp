@@ -16,6 +16,9 @@ struct RigidCore;
 // against the capstan); 0 when there is none. The speed ratio is the core's
 // angular velocity over this.
 double noSlipAngularVelocity(const Scene& scene, const RigidCore& core);
+// The speed ratio of a core turning at angularVelocity: that over the no-slip one; NaN where
+// there is none.
+double speedRatio(const Scene& scene, const RigidCore& core, double angularVelocity);
 
 // Why a step may have no equilibrium at all: a core's applied torque beyond
 // what friction in the nip can carry ("; support ...: ..."), or empty.

@@ -111,11 +111,11 @@ std::string SteadyRolling::rollerTurningBackwards() const {
   // drive on 4 cells round with the capstan reversed converged with a speed ratio of -13.8
   // (randomized sweep 12; 8 cells round: 0.967, the shipped mesh 0.987).
   for (const auto& core : m_.assembly->rigidCores()) {
-    const double rolling = noSlipAngularVelocity(m_.scene, core);
-    if (!core.free[3] || core.holding() || rolling == 0 || core.angularVelocity / rolling >= 0) continue;
+    const double ratio = speedRatio(m_.scene, core, core.angularVelocity);
+    if (!core.free[3] || core.holding() || !(ratio < 0)) continue;
     return format("support '%s': the steady state found has the roller's surface running against the capstan's "
                   "(speed ratio %.4g), which no nip carries: the mesh does not resolve the nip (finer Mesh/Cells "
-                  "round the ring)", core.name.c_str(), core.angularVelocity / rolling);
+                  "round the ring)", core.name.c_str(), ratio);
   }
   return "";
 }

@@ -2,6 +2,7 @@
 
 #include <Teuchos_CommHelpers.hpp>
 
+#include <cmath>
 #include <map>
 
 #include "rolling.hpp"
@@ -64,9 +65,9 @@ void measureStep(const Model& model, const std::vector<StepRecord>& earlier, Ste
     // Steady rolling: the angular velocity is the core's unknown itself.
     sr.angularVelocity = model.scene.analysis.steady() ? core.angularVelocity
                                                        : (core.rotation - before) / (rec.time - tBefore);
-    const double rolling = noSlipAngularVelocity(model.scene, core);
-    sr.hasSpeedRatio = rolling != 0;
-    if (sr.hasSpeedRatio) sr.speedRatio = sr.angularVelocity / rolling;
+    const double ratio = speedRatio(model.scene, core, sr.angularVelocity);
+    sr.hasSpeedRatio = !std::isnan(ratio);
+    if (sr.hasSpeedRatio) sr.speedRatio = ratio;
   }
 }
 
