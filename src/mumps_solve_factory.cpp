@@ -180,64 +180,17 @@ class MumpsInverseOp : public Thyra::LinearOpBase<double> {
   RCP<const MumpsSolver::CrsMatrix> matrix_;
 };
 
-const std::vector<std::pair<const char*, MumpsOptions::Ordering>> kOrderings = {
-    {"Auto", MumpsOptions::Ordering::Auto},   {"Metis", MumpsOptions::Ordering::Metis},
-    {"Pord", MumpsOptions::Ordering::Pord},
-    {"AMD", MumpsOptions::Ordering::Amd},     {"AMF", MumpsOptions::Ordering::Amf},
-    {"QAMD", MumpsOptions::Ordering::Qamd}};
-
 }  // namespace
-
-RCP<const Teuchos::ParameterList> validMumpsOptions() {
-  static RCP<Teuchos::ParameterList> valid;
-  if (valid.is_null()) {
-    valid = Teuchos::parameterList("MUMPS");
-    valid->set("Ordering", std::string("Auto"),
-               "Fill-reducing ordering: Auto (Metis and QAMD analysed, the fewer estimated flops kept) | Metis "
-               "(METIS_NodeND, computed by capstan) | Pord | AMD | AMF | QAMD "
-               "(src/direct_solver.hpp has the measurements)");
-    valid->set("Verbose", false, "MUMPS' own printing");
-    valid->set("Scaling", false, "Row and column scaling before each factorisation (MUMPS' automatic choice)");
-    valid->set("Host Only Below", 2000,
-               "Matrices with fewer rows are factored on rank 0 alone, larger ones by every rank; 0: always every "
-               "rank (src/direct_solver.hpp has the measurements)");
-    valid->set("Precision", std::string("Double"),
-               "Double | Single: the factorisation's arithmetic; Single (half the memory) only as GMRES' "
-               "preconditioner (Solver/Preconditioner = LU), whose iterations restore double precision");
-    valid->set("Nonzero Node Blocks", false,
-               "With Nonzero Pattern: a row's entries in one node's columns join the pattern together once any is "
-               "nonzero; capstan sets it without friction");
-    valid->set("Symmetric Part", false,
-               "Factor (A + A^T) / 2 as a symmetric matrix (LDL^T): half the work, for GMRES' preconditioner "
-               "(Solver/Preconditioner = LU) where A is nearly symmetric; capstan sets it without friction");
-    valid->set("Nonzero Pattern", true,
-               "MUMPS sees the entries nonzero so far (and the diagonal), the analysis redone when one more turns "
-               "nonzero; false: the matrix graph's whole pattern");
-  }
-  return valid;
-}
 
 // The factories' parameter list into the shared options (the next
 // factorisation uses them).
 void readMumpsOptions(Teuchos::ParameterList& list, MumpsShared& shared) {
+  try {
+    shared.options = mumpsOptionsFrom(list);
+  } catch (const MumpsParameterError& e) {
+    throw std::invalid_argument("MUMPS: '" + e.name + "': " + e.what());
+  }
   list.validateParametersAndSetDefaults(*validMumpsOptions(), 0);
-  const auto ordering = list.get<std::string>("Ordering");
-  bool known = false;
-  for (const auto& [name, value] : kOrderings)
-    if (ordering == name) shared.options.ordering = value, known = true;
-  if (!known) throw std::invalid_argument("MUMPS: 'Ordering' = '" + ordering + "' is not Auto, Metis, Pord, AMD, AMF or QAMD");
-  shared.options.verbose = list.get<bool>("Verbose");
-  shared.options.scaling = list.get<bool>("Scaling");
-  shared.options.nonzeroPattern = list.get<bool>("Nonzero Pattern");
-  shared.options.symmetricPart = list.get<bool>("Symmetric Part");
-  shared.options.nonzeroNodeBlocks = list.get<bool>("Nonzero Node Blocks");
-  const auto precision = list.get<std::string>("Precision");
-  if (precision != "Double" && precision != "Single")
-    throw std::invalid_argument("MUMPS: 'Precision' = '" + precision + "' is not Double or Single");
-  shared.options.precision = precision == "Single" ? MumpsOptions::Precision::Single : MumpsOptions::Precision::Double;
-  const int hostOnlyBelow = list.get<int>("Host Only Below");
-  if (hostOnlyBelow < 0) throw std::invalid_argument("MUMPS: 'Host Only Below' = " + std::to_string(hostOnlyBelow) + " is negative");
-  shared.options.hostOnlyBelow = hostOnlyBelow;
   shared.solver.reset();
   shared.factoredFor = nullptr;
   shared.singleConfirmed = false;

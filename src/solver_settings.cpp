@@ -2,6 +2,8 @@
 
 #include <cctype>
 
+#include "mumps_parameters.hpp"
+
 namespace capstan {
 
 namespace {
@@ -212,6 +214,15 @@ SolverSettings SolverSettings::parse(const ParameterList& sol, const ParameterRe
                  ") crashes on capstan's matrices in Trilinos 13.2; use RELAXATION or CHEBYSHEV");
   }
   s.stratimikos = sol.sublist("Stratimikos");
+  // capstan's own MUMPS lists, checked whether or not this run builds the solver they set.
+  for (const char* kind : {"Linear Solver Types", "Preconditioner Types"}) {
+    if (!s.stratimikos.isSublist(kind) || !s.stratimikos.sublist(kind).isSublist("MUMPS")) continue;
+    try {
+      mumpsOptionsFrom(s.stratimikos.sublist(kind).sublist("MUMPS"));
+    } catch (const MumpsParameterError& e) {
+      r.fail(std::string("Solver/Stratimikos/") + kind + "/MUMPS/" + e.name, e.what());
+    }
+  }
   s.belos = sol.sublist("Belos");
   s.ifpack2 = sol.sublist("Ifpack2");
   return s;

@@ -10,7 +10,7 @@ unknown face names, a zero axis direction, Radius <= 0, malformed XML (unclosed,
 mismatched, duplicated, too deeply nested, unknown elements), an empty file,
 binary garbage, a missing scene file, an output directory under a regular file,
 bad NOX, Stratimikos, Belos and Ifpack2 sublists (MueLu's own parameters too, MUMPS'
-Precision), a mesh with fewer cells than ranks, numbers beyond the magnitudes capstan
+Precision, also in a MUMPS list the run does not use, and by `capstan validate`), a mesh with fewer cells than ranks, numbers beyond the magnitudes capstan
 computes with (1e-25 to 1e25), cells flatter than 1e-6, parameters of another support
 type, two supports prescribing one component, and bad --set values.
 
@@ -226,6 +226,20 @@ for label, solver, value in (("MUMPS: unknown precision", "GMRES", "Quad"),
                        f'<Parameter name="Precision" type="string" value="{value}"/>'
                        '</ParameterList></ParameterList></ParameterList></ParameterList><ParameterList name="Output">')],
               "Precision")
+# A MUMPS list the run does not use (GMRES, the default preconditioner) is checked as well, and
+# by `capstan validate`, its parameter named in full (randomized sweep 13: Precision = Half ran to
+# exit 0, and validate passed any value).
+unused = ('<ParameterList name="Output">',
+          '<ParameterList name="Solver"><Parameter name="Linear Solver" type="string" value="GMRES"/>'
+          '<ParameterList name="Stratimikos"><ParameterList name="Linear Solver Types"><ParameterList name="MUMPS">'
+          '<Parameter name="Precision" type="string" value="Half"/>'
+          '</ParameterList></ParameterList></ParameterList></ParameterList><ParameterList name="Output">')
+MUMPS_PATH = "Solver/Stratimikos/Linear Solver Types/MUMPS/Precision"
+bad_value("MUMPS: unused list, unknown precision", [unused], MUMPS_PATH)
+f = scene_file("mumps_unused_validate.xml", edited(unused))
+p = T.capstan_run(["validate", f], cwd=work)
+T.check(p.returncode == 1 and MUMPS_PATH in p.stderr and f in p.stderr,
+        f"validate, an unused MUMPS list's unknown precision: exit {p.returncode} (1), names the file and {MUMPS_PATH}")
 # MueLu reads its list only when it builds a preconditioner: capstan builds one before
 # the run when a scene passes its own (an unknown smoother, a value of the wrong type).
 for label, param in (("MueLu: unknown smoother", '<Parameter name="smoother: type" type="string" value="Bogus"/>'),
