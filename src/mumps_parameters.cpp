@@ -48,9 +48,11 @@ MumpsOptions mumpsOptionsFrom(const Teuchos::ParameterList& list) {
   const auto valid = validMumpsOptions();
   for (const auto& entry : list) {
     const std::string& name = entry.first;
-    if (!valid->isParameter(name))
-      throw MumpsParameterError(name, "unknown (capstan's MUMPS takes Ordering, Verbose, Scaling, Host Only Below, "
-                                      "Precision, Nonzero Node Blocks, Symmetric Part, Nonzero Pattern)");
+    if (!valid->isParameter(name)) {
+      std::string names;  // the valid list's own, in its order
+      for (const auto& known : *valid) names += (names.empty() ? "" : ", ") + known.first;
+      throw MumpsParameterError(name, "unknown (capstan's MUMPS takes " + names + ")");
+    }
     const auto& want = valid->getEntry(name).getAny(false);
     const auto& got = entry.second.getAny(false);
     if (entry.second.isList() || got.type() != want.type())
