@@ -52,6 +52,9 @@ class AugmentationLoop {
   // Newton's reference), adding to rec; false with `failure` set (the caller restores u and the
   // multipliers). passLimit > 0: stop after that many passes, met or not (a first guess).
   bool solve(double t, double bare, StepRecord& rec, std::string& failure, int passLimit = 0);
+  // At u (evaluated here): whether no contact point of any capstan sticks
+  // (every rank; false without friction).
+  bool everyPointSlips();
   // Coulomb: whether a failed solve may go on in pseudo-time while points
   // stick (LoadStepper: in sub-steps cut a few times; otherwise only where
   // every point slips, see solvePositions).
@@ -130,9 +133,6 @@ class AugmentationLoop {
   // Debugging aid: the assembled tangent against a central difference of the
   // residual along a random direction, logged (topic newton, or stdout).
   void checkTangent();
-  // At u (evaluated here): whether no contact point of any capstan sticks
-  // (every rank; false without friction).
-  bool everyPointSlips();
   // Whether some friction acts and every acting one's law is regularised now.
   bool lawsRegularisedNow() const;
 

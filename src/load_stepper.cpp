@@ -20,6 +20,11 @@ constexpr double kPseudoTimeWithStickSubstep = 1.0 / 8;
 // creep on; ten halvings reach the smallest sub-step, and converging runs need far fewer cuts
 // (docs/numerics.md, "Load steps").
 constexpr int kMostCutsPerStep = 40;
+// A braked roller whose surface moves at under this fraction of the capstan's while every contact
+// point slips stands: friction is at its limit everywhere, so the rotation is free and the brake
+// is held by the mesh, not the nip (the braked slice on 4x40 cells at 1.35 N mm: speed ratio 0
+// through steps 3-20 at exit 0, where 4x64 and 8x128 end with exit 2; docs/pinch-roller.md).
+constexpr double kStalledSpeedRatio = 1e-3;
 
 // How long after t the first of the cores' external loads (forces, torques) still ramping is
 // in: 0 once all are. A cut halves that span, so the load that comes in first eases first: with
@@ -47,8 +52,27 @@ LoadStepper::LoadStepper(Model& model, Log& log, bool checkTangent, double tDone
 bool LoadStepper::solveIncrement(double t0, double t1, StepRecord& rec, std::string& failure) {
   m_.assembly->setInterval(t0, t1);
   if (m_.scene.analysis.steady()) return steady_.solve(t1, rec, failure);
+  std::vector<double> rotations;
+  for (const auto& core : m_.assembly->rigidCores()) rotations.push_back(core.rotation);
   const double bare = predictors_.firstGuess(t0, t1, rec);
-  return augmentation_.solve(t1, bare, rec, failure);
+  if (!augmentation_.solve(t1, bare, rec, failure)) return false;
+  failure = brakedRollerStalled(rotations, t1 - t0);
+  return failure.empty();
+}
+
+std::string LoadStepper::brakedRollerStalled(const std::vector<double>& rotations, double dt) {
+  const auto& cores = m_.assembly->rigidCores();
+  for (size_t c = 0; c < cores.size(); ++c) {
+    const auto& core = cores[c];
+    if (!core.free[3] || core.holding() || core.torque == 0) continue;
+    const double ratio = speedRatio(m_.scene, core, (core.rotation - rotations[c]) / dt);
+    if (!(ratio < kStalledSpeedRatio) || !augmentation_.everyPointSlips()) continue;
+    return format("support '%s': the braked roller stands or turns back (speed ratio %.4g over the increment) while "
+                  "every contact point slips: the nip does not carry the brake (the mesh's normal forces off the line "
+                  "of centres take up the rest)",
+                  core.name.c_str(), ratio);
+  }
+  return "";
 }
 
 bool LoadStepper::advance(StepRecord& rec, std::string& failure) {

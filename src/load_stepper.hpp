@@ -5,6 +5,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "augmentation.hpp"
 #include "log.hpp"
@@ -29,6 +30,10 @@ class LoadStepper {
 
  private:
   bool solveIncrement(double t0, double t1, StepRecord& rec, std::string& failure);
+  // Quasi-static: why the increment's converged state is no answer, or empty: a braked core free
+  // to turn that stands or turns back while every contact point slips (rotations: the cores'
+  // at the increment's start, dt its length).
+  std::string brakedRollerStalled(const std::vector<double>& rotations, double dt);
 
   Model& m_;
   Log& log_;

@@ -14,7 +14,8 @@ Braked roller (Torque 0.15 and 0.3 N mm per mm): the core torque equals the brak
 capstan torque and the core torque balance through the nip force (ratio = -R_capstan /
 R_roller, the roller's radius measured from its displaced axis to the capstan's surface)
 within 2%, and the speed ratio falls as the brake grows. A brake beyond mu F R ends with
-exit 2 and a reason naming it, the converged steps kept.
+exit 2 and a reason naming it, the converged steps kept; so does one just beyond it on a
+coarse nip (4x40), where the mesh could hold the roller still while every point slips.
 
 Axial symmetry: the full 3D roller (a short one, free ends) is symmetric about its
 mid-length plane to 1e-8.
@@ -127,6 +128,18 @@ p, s, outdir = T.run_scene(braked_scene, "too-much", sets=["Supports/core/Torque
 T.check("exceeds what friction in the nip can carry" in p.stderr, "too large a brake: the message says why")
 T.check(s is not None and s["converged"] is False and "no quasi-static equilibrium" in (s["failure"] or ""),
         "summary.json: converged false, failure names the brake")
+T.conforms(outdir, braked_scene)
+
+# The same on a coarse nip (4x40), just beyond the limit: the mesh's normal forces off the line of
+# centres can hold the roller still while every point slips, which converged to exit 0 with a speed
+# ratio of 0 from step 3 on; it must end with exit 2 and say why.
+p, s, outdir = T.run_scene(braked_scene, "coarse-stall", sets=["Supports/core/Torque=1.35", "Mesh/Cells={4, 40, 1}"],
+                           expect_rc=2)
+T.check("while every contact point slips" in p.stderr and "exceeds what friction in the nip can carry" in p.stderr,
+        "a stalled braked roller on a coarse nip: exit 2, the message says why")
+T.check(s is not None and s["converged"] is False and "every contact point slips" in (s["failure"] or "") and
+        all(abs(st["supports"]["core"]["speed_ratio"]) > 1e-3 for st in s["steps"]),
+        "summary.json: converged false, the failure says why, no kept step with the roller standing")
 T.conforms(outdir, braked_scene)
 
 # Axial symmetry of the 3D roller (short, free ends): the mid-length plane is z = 2.
