@@ -265,6 +265,39 @@ class Stall : public NOX::StatusTest::Generic {
   NOX::StatusTest::StatusType status_ = NOX::StatusTest::Unconverged;
 };
 
+// Sets `from`'s parameters in `to` (sublists merged, as ParameterList::setParameters) as entries
+// nobody has read yet: the scene reader's reading marked the scene's own (unreadParameters).
+void setUnread(const Teuchos::ParameterList& from, Teuchos::ParameterList& to) {
+  for (auto it = from.begin(); it != from.end(); ++it) {
+    const std::string& name = from.name(it);
+    if (from.isSublist(name)) {
+      setUnread(from.sublist(name), to.sublist(name));
+      continue;
+    }
+    Teuchos::ParameterEntry fresh;
+    fresh.setAnyValue(from.entry(it).getAny(false));
+    to.setEntry(name, fresh);
+  }
+}
+
+// The leaves of `given` (paths below it, from `prefix`) whose copies in `used` nobody read:
+// Teuchos marks an entry used when its value is got (getAny(false) does not).
+void unreadParameters(const Teuchos::ParameterList& given, const Teuchos::ParameterList& used,
+                      const std::string& prefix, std::vector<std::string>& out) {
+  for (auto it = given.begin(); it != given.end(); ++it) {
+    const std::string& name = given.name(it);
+    const auto* entry = used.getEntryPtr(name);
+    if (given.isSublist(name)) {
+      unreadParameters(given.sublist(name),
+                       entry && entry->isList() ? Teuchos::any_cast<Teuchos::ParameterList>(entry->getAny(false))
+                                                : Teuchos::ParameterList(),
+                       prefix + name + "/", out);
+      continue;
+    }
+    if (!entry || !entry->isUsed()) out.push_back(prefix + name);
+  }
+}
+
 }  // namespace
 
 struct NewtonSolver::Impl {
@@ -285,6 +318,8 @@ struct NewtonSolver::Impl {
   FailureAgreement agreement;
   StallRule stall;            // off: window 0
   StallRule pseudoTimeStall;  // off: window 0
+  bool noxChecked = false;              // the scene's NOX names checked (takeUnreadNoxParameters)
+  std::vector<std::string> noxUnread;   // those NOX did not read, until taken
   Impl(Assembly& a, const SolverSettings& s) : assembly(a), solver(s), agreement(a.dofMap()->getComm()) {}
 
   RCP<Teuchos::ParameterList> noxParameters(const RCP<NOX::Observer>& observer) const {
@@ -322,7 +357,7 @@ struct NewtonSolver::Impl {
     // whatever the print level; capstan reports the outcome itself.
     params->sublist("Printing").set<RCP<std::ostream>>("Output Stream", rcp(new Teuchos::oblackholestream));
     params->sublist("Solver Options").set<RCP<NOX::Observer>>("Observer", observer);
-    params->setParameters(solver.nox);
+    setUnread(solver.nox, *params);
     return params;
   }
 };
@@ -515,6 +550,14 @@ std::string NewtonSolver::agree(const std::string& failure) const { return impl_
 double NewtonSolver::preconditionerSeconds() const { return impl_->preconditionerSeconds; }
 const Teuchos::ParameterList& NewtonSolver::linearSolverParameters() const { return impl_->strat; }
 
+std::vector<std::string> NewtonSolver::takeUnreadNoxParameters(bool runEnded) {
+  if (runEnded && !impl_->noxChecked) {
+    impl_->noxChecked = true;
+    unreadParameters(impl_->solver.nox, Teuchos::ParameterList(), "", impl_->noxUnread);
+  }
+  return std::move(impl_->noxUnread);
+}
+
 namespace {
 // Pseudo-transient continuation (NewtonSolver::pseudoTransient): the first
 // pseudo-time step (the diagonal's shift is |diag W| / dtau; 10, 100 and 1000
@@ -687,6 +730,10 @@ NewtonResult NewtonSolver::solve(Vector& u, double tolerance) {
   r.failure = impl_->agreement.agree(r.failure);
   auto& out = params->sublist("Direction").sublist("Newton").sublist("Linear Solver").sublist("Output");
   r.linearIterations = out.get("Cumulative Iteration Count", 0);
+  if (!impl_->noxChecked && r.iterations > 0) {
+    impl_->noxChecked = true;
+    unreadParameters(impl_->solver.nox, *params, "", impl_->noxUnread);
+  }
   r.residualHistory = history->norms;
   r.stepLengths = history->steps;
   r.converged = status == NOX::StatusTest::Converged && r.failure.empty() && std::isfinite(r.residualNorm);

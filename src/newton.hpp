@@ -92,6 +92,11 @@ class NewtonSolver {
   bool direct() const;
   // The linear solver and preconditioner parameters in use (Stratimikos list).
   const Teuchos::ParameterList& linearSolverParameters() const;
+  // Once, after the run's first Newton solve that took an iteration: the scene's Solver/NOX
+  // parameters (paths below Solver/NOX) that NOX did not read there. NOX ignores what it does not
+  // read, so such a name is misspelt or belongs to a method this run does not use. With runEnded
+  // and no such solve yet (the monolithic pressure loop's Newton is capstan's own): all of them.
+  std::vector<std::string> takeUnreadNoxParameters(bool runEnded = false);
 
  private:
   struct Impl;

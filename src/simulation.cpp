@@ -55,9 +55,11 @@ class Simulation {
       rec.step = step;
       rec.time = step * scene_.stepSize;
       ok = stepper.advance(rec, failure);
+      warnOfUnreadNoxParameters();
       for (auto& what : solver_switches::take()) switches_.push_back({step, std::move(what)});
       if (ok) finishStep(rec, stepper, stepStart);
     }
+    warnOfUnreadNoxParameters(true);
     if (!ok) {
       model_->assembly->evaluate(*model_->u, nullptr, nullptr);  // final figures: last converged state
       failure += distortionNote(model_->assembly->bricks().mostCompressed(*comm_));
@@ -85,6 +87,19 @@ class Simulation {
         std::fprintf(stderr, "capstan: WARNING: %s: parameter 'Mesh/Cells', 'Capstans/%s/Radius': %s\n",
                      scene_.file.c_str(), contacts[i]->capstan().name.c_str(), contacts[i]->coarseFacesWarning().c_str());
     }
+  }
+
+  // NOX ignores names it does not read: say so once the first Newton solve has read its list, or at
+  // the run's end where no Newton iteration went through NOX.
+  void warnOfUnreadNoxParameters(bool runEnded = false) const {
+    for (const auto& path : model_->newton->takeUnreadNoxParameters(runEnded))
+      if (model_->rank0)
+        std::fprintf(stderr, "capstan: WARNING: %s: parameter 'Solver/NOX/%s': %s, so it had no effect%s\n",
+                     scene_.file.c_str(), path.c_str(),
+                     runEnded ? "no Newton iteration of this run went through NOX"
+                              : "NOX did not read it in the run's first Newton solve",
+                     runEnded ? " (the monolithic pressure loop takes its Newton steps itself, without NOX)"
+                              : " (misspelt, or for a method this run does not use)");
   }
 
   // The output directory, the files a restart continues, the initial state.

@@ -124,7 +124,7 @@ void SolverSettings::declare(ParameterList& sol) {
           "cannot be evaluated in double precision; the pressure loop still makes v_e = V_e exact. "
           "-1: automatic, 3e-2 with the Saddle Point pressure update without friction, 1e-2 otherwise "
           "(and where the pressure loop is monolithic)");
-  sol.sublist("NOX", false, "Passed to NOX unchanged, over capstan's defaults (NOX ignores names it does not read: a misspelt one has no effect)");
+  sol.sublist("NOX", false, "Passed to NOX unchanged, over capstan's defaults (NOX ignores names it does not read: a name NOX did not read in the run's first Newton solve is a warning)");
   sol.sublist("Stratimikos", false, "Passed to Stratimikos unchanged, over capstan's defaults (Ifpack2's block relaxation, which crashes in Trilinos 13.2, is refused)");
   sol.sublist("Belos", false,
               "Passed to the Belos solver (Block GMRES, or Pseudo Block CG with Linear Solver = CG) unchanged, "

@@ -12,7 +12,10 @@ each converges, conforms to interface.md and agrees with the defaults on every
 step's support and capstan forces to 1e-8 (the same converged state), while its
 Krylov iteration count differs (the sublist took effect). An int given where
 Ifpack2 takes a double (a damping factor of 1) is read as a double. Misspelt names
-and values Belos refuses are bad input: tests/integration/bad_input.py.
+and values Belos refuses are bad input: tests/integration/bad_input.py. NOX ignores
+names it does not read: a Solver/NOX name that NOX did not read in the run's first
+Newton solve is a warning naming its path, once, on 1 and 2 ranks (a name it read
+gives none); on G1, whose monolithic pressure loop does without NOX, every one is.
 """
 import os
 import sys
@@ -44,6 +47,24 @@ p, s, out = T.run_scene(base, "jacobi-damping", sets=["Solver/Linear Solver=GMRE
                                                       "Solver/Ifpack2/relaxation: damping factor=1"])
 T.check(s is not None and s["converged"] is True, "Jacobi with --set 'Solver/Ifpack2/relaxation: damping factor=1' "
                                                   "(an int where Ifpack2 takes a double) runs and converges")
+
+# NOX ignores names it does not read: a name NOX read in the first Newton solve runs silently, one
+# it did not (misspelt, or for a line search the run does not use) is a warning naming its path; on
+# G1, whose monolithic pressure loop takes its Newton steps without NOX, every NOX name is.
+slice_scene = T.input("pinch-roller-slice.xml")
+nox = ["Time/Steps=1", "Output/Write Fields=false"]
+read, unread = "Solver/NOX/Line Search/Backtrack/Max Iters", ("Solver/NOX/Foo", "Solver/NOX/Line Search/Polynomial/Max Iters")
+for ranks in (1, 2):
+    p, s, out = T.run_scene(slice_scene, f"nox-{ranks}", sets=nox + [f"{read}=12"] + [f"{u}=5" for u in unread],
+                            ranks=ranks, quiet=False)
+    T.check(f"'{read}'" not in p.stderr, f"{ranks} rank(s): {read} (read by NOX): no warning")
+    for path in unread:
+        T.check(p.stderr.count(f"parameter '{path}': NOX did not read it") == 1,
+                f"{ranks} rank(s): {path} (not read by NOX): one warning naming it")
+    T.check(s is not None and s["converged"] is True, f"{ranks} rank(s): the run with unread NOX names converges")
+p, s, out = T.run_scene(base, "nox-g1", sets=nox + [f"{read}=12"], quiet=False)
+T.check(p.stderr.count(f"parameter '{read}': no Newton iteration of this run went through NOX") == 1,
+        f"G1 (monolithic, no NOX solve): {read} is a warning")
 
 if len(runs) == 3:
     a = runs["defaults"]
