@@ -5,6 +5,8 @@
 
 #include "assembly.hpp"
 #include "errors.hpp"
+#include "log.hpp"
+#include "mesh.hpp"
 #include "parameters.hpp"
 #include "vec3.hpp"
 
@@ -43,6 +45,32 @@ std::string brakeDiagnosis(const Scene& scene) {
              " exceeds what friction in the nip can carry (mu |Force| R = " + brief(mu) + " x " + brief(F) +
              " x " + brief(scene.mesh.outerRadius) + " = " + brief(capacity) +
              "): there is no quasi-static equilibrium, the roller would stop and the capstan slip";
+  }
+  return out;
+}
+
+namespace {
+// Quasi-static rolling follows the nip while the capstan's surface moves a few of its cells a step.
+// The free slice's speed ratio (steps 6-20; steady rolling: 0.991) against the capstan's speed,
+// in nip cells a step: 0.28 (shipped) mean 0.989, range 0.980-0.996; 0.84: 0.992, 0.990-0.994;
+// 2.8: 0.998, 0.957-1.032; 8.4: 1.012, 0.996-1.067; 28: 1.064, 1.002-1.130 (docs/pinch-roller.md).
+constexpr double kMostNipCellsPerStep = 3;
+}  // namespace
+
+std::string fastRollingDiagnosis(const Scene& scene) {
+  if (scene.mesh.type != MeshSpec::Type::Annulus || scene.analysis.steady()) return "";
+  const auto& m = scene.mesh;
+  const double cell = m.outerRadius * (M_PI / 180) * AnnulusGenerator::narrowestRingCellDegrees(m.cells[1], m.fineSector);
+  std::string out;
+  for (const auto& c : scene.capstans) {
+    const double travel = std::fabs(c.angularVelocity) * c.radius * scene.stepSize;
+    if (!(travel > kMostNipCellsPerStep * cell)) continue;
+    out += std::string(out.empty() ? "" : "; ") +
+           format("capstan '%s': its surface moves %.3g a step (|Angular Velocity| x Radius x Step Size), %.3g of the "
+                  "annulus' narrowest cells round (%.3g wide): quasi-static rolling follows the nip to about %g "
+                  "cells a step; beyond, the speed ratio strays (the slice: by 2%% at 8 cells a step, 7%% at 28): "
+                  "take a smaller Time/Step Size, or Analysis/Type = Steady Rolling",
+                  c.name.c_str(), travel, travel / cell, cell, kMostNipCellsPerStep);
   }
   return out;
 }

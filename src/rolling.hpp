@@ -31,6 +31,11 @@ std::string brakeDiagnosis(const Scene& scene);
 // ("support ...: ..."), or empty; the scene warns of it and a failed run repeats it.
 std::string rollOffDiagnosis(const Scene& scene);
 
+// Why quasi-static rolling may miss the nip: a spinning capstan's surface moving more than
+// kMostNipCellsPerStep of the annulus' narrowest cells round in a step, beyond which the speed
+// ratio strays (the description, "capstan ...: ..."), or empty; the scene warns of it.
+std::string fastRollingDiagnosis(const Scene& scene);
+
 // What to try where a rolling step on an annulus under Coulomb's exact stick stalled (failure: its
 // reason), or empty: stick and slip can chatter on a fine nip over a thick outer cell, where a Tanh
 // law or more radial cells converge (docs/steady-rolling.md, "Stick and slip that cycle").

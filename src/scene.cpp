@@ -891,6 +891,8 @@ Scene parseScene(const std::string& content, const std::string& file, const std:
   rejectSingularCores(sc, v);
   if (const std::string rollOff = rollOffDiagnosis(sc); !rollOff.empty())
     sc.warnings.push_back(sc.file + ": parameter 'Supports': " + rollOff);
+  if (const std::string fast = fastRollingDiagnosis(sc); !fast.empty())
+    sc.warnings.push_back(sc.file + ": parameter 'Time/Step Size': " + fast);
   for (auto& s : sc.supports)
     if (s.isCore() && s.rampTime == 0) s.rampTime = sc.stepSize;
   for (auto& s : sc.supports)
