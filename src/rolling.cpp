@@ -52,8 +52,9 @@ std::string brakeDiagnosis(const Scene& scene) {
 namespace {
 // Quasi-static rolling follows the nip while the capstan's surface moves a few of its cells a step.
 // The free slice's speed ratio (steps 6-20; steady rolling: 0.991) against the capstan's speed,
-// in nip cells a step: 0.28 (shipped) mean 0.989, range 0.980-0.996; 0.84: 0.992, 0.990-0.994;
-// 2.8: 0.998, 0.957-1.032; 8.4: 1.012, 0.996-1.067; 28: 1.064, 1.002-1.130 (docs/pinch-roller.md).
+// in nip cells a step: 0.28 (shipped) mean 0.989, range 0.980-0.996; 0.83: 0.992, 0.990-0.994;
+// 2.8: 0.998, 0.957-1.032; 8.3: 1.012, 0.996-1.067; 28: 1.064, 1.002-1.130 (docs/friction.md,
+// "How fast a quasi-static roll may go").
 constexpr double kMostNipCellsPerStep = 3;
 }  // namespace
 
