@@ -49,11 +49,10 @@ LoadStepper::LoadStepper(Model& model, Log& log, bool checkTangent, double tDone
     : m_(model), log_(log), predictors_(model, log), augmentation_(model, log, checkTangent),
       steady_(model, log, augmentation_, predictors_, tDone > 0), tDone_(tDone) {}
 
-bool LoadStepper::solveIncrement(double t0, double t1, StepRecord& rec, std::string& failure) {
+bool LoadStepper::solveIncrement(double t0, double t1, const std::vector<double>& rotations, StepRecord& rec,
+                                  std::string& failure) {
   m_.assembly->setInterval(t0, t1);
   if (m_.scene.analysis.steady()) return steady_.solve(t1, rec, failure);
-  std::vector<double> rotations;
-  for (const auto& core : m_.assembly->rigidCores()) rotations.push_back(core.rotation);
   const double bare = predictors_.firstGuess(t0, t1, rec);
   if (!augmentation_.solve(t1, bare, rec, failure)) return false;
   failure = brakedRollerStalled(rotations, t1 - t0);
@@ -104,7 +103,7 @@ bool LoadStepper::advance(StepRecord& rec, std::string& failure) {
     for (const auto& core : assembly.rigidCores()) rotationsSaved.push_back(core.rotation);
     std::string why;
     augmentation_.allowPseudoTimeWithStick(!steady && tEnd - tDone_ <= kPseudoTimeWithStickSubstep * dt * (1 + 1e-12));
-    if (solveIncrement(tDone_, tEnd, rec, why)) {
+    if (solveIncrement(tDone_, tEnd, rotationsSaved, rec, why)) {
       predictors_.remember(saved.u, tDone_, rotationsSaved);
       tDone_ = tEnd;
       // History (friction) moves on to this converged state; the step's

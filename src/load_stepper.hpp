@@ -29,7 +29,9 @@ class LoadStepper {
   Predictors& predictors() { return predictors_; }
 
  private:
-  bool solveIncrement(double t0, double t1, StepRecord& rec, std::string& failure);
+  // rotations: the cores' at t0 (the increment's start).
+  bool solveIncrement(double t0, double t1, const std::vector<double>& rotations, StepRecord& rec,
+                      std::string& failure);
   // Quasi-static: why the increment's converged state is no answer, or empty: a braked core free
   // to turn that stands or turns back while every contact point slips (rotations: the cores'
   // at the increment's start, dt its length).
